@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages sph needs to build, run and test, when they
+# are missing. Usable as root or through sudo. Options:
+#   --with-ffmpeg   also install ffmpeg (sph run then assembles an mp4)
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git
+  libyaml-dev       # scene files (libyaml document API)
+  libmatheval-dev   # expressions in scene files (velocity profiles)
+  check             # unit test framework
+  libpng-dev        # PNG frames
+  libosmesa6-dev    # off-screen OpenGL renderer
+  libfreetype-dev fonts-dejavu-core  # text on frames
+  python3-vtk9      # VTK's own reader validates the files we write (tests)
+  clang-format      # formatting is a test
+)
+for arg in "$@"; do
+  case "$arg" in
+    --with-ffmpeg) packages+=(ffmpeg) ;;
+    *) echo "bootstrap.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "bootstrap: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "bootstrap: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo=(sudo)
+fi
+echo "bootstrap: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,71 @@
+/* Kernel corrections on a particle cloud (reference configuration for
+ * total-Lagrangian methods), stored per directed pair in the CSR order of an
+ * sph_neighbors list.
+ *
+ *  - gradient correction matrix L_a (seed 001 eq. 8, seed 000 eq. 21):
+ *      L_a = ( sum_b V_b grad W_b(X_a) (x) (X_b - X_a) )^-1 , applied as
+ *      corrected grad W_b(X_a) = L_a grad W_b(X_a); the sum is arranged so that
+ *      sum_b V_b (f_b - f_a) (x) corrected grad W_b(X_a) = grad f exactly for
+ *      linear f.
+ *  - zeroth-order corrected kernel W~0 (seed 004 eq. 10) and its gradient
+ *      (eq. 13-14), with the correction L of eq. 11-12 applied to it;
+ *  - first-order corrected kernel W~1 (seed 004 eq. 6-8) and its exact
+ *      gradient (seed 004 App. A, eq. A.1-A.6);
+ *  - corrected Laplacian (seed 000 App. A, eq. A.2-A.5) with the quadratic
+ *      condition generalised to d dimensions (sum V |r|^2 Lap W~ = 2d).
+ *
+ * Pair quantities with "_b(X_a)" are those of particle b seen from a, stored
+ * at the slot of b in a's list. The self pair (b = a) is not in the list; its
+ * kernel value W(0) enters the W~0/W~1 sums and is returned separately.
+ *
+ * In 2D (plane strain) the moment matrices are 2x2 blocks and L has
+ * L_zz = 1, L_xz = L_zx = ... = 0; 1D likewise keeps only the xx entry.
+ * A moment matrix whose reciprocal 1-norm condition number falls below
+ * `rcond_min` (default 1e-10) is reported as SPH_ERR_SINGULAR naming the
+ * particle id and its position, never inverted into NaN. */
+#ifndef SPH_CORRECTIONS_H
+#define SPH_CORRECTIONS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sph/kernel.h"
+#include "sph/neighbors.h"
+#include "sph/status.h"
+
+/* Which corrected gradient a method asks for. */
+typedef enum sph_gradient_kind {
+  SPH_GRAD_UNCORRECTED = 0, /* grad W (seed 000 eq. 22) */
+  SPH_GRAD_CORRECTED,       /* L grad W (seed 000 eq. 21, seed 001 eq. 8) */
+  SPH_GRAD_CORRECTED_W0,    /* L grad W~0 (seed 004 eq. 11-14) */
+  SPH_GRAD_W1               /* grad W~1 (seed 004 App. A) */
+} sph_gradient_kind;
+
+/* Geometry the corrections are computed on. */
+typedef struct sph_cloud {
+  size_t n;
+  int dim;
+  const double *x;      /* 3*n positions */
+  const double *volume; /* n volumes */
+  const int64_t *id;    /* n ids for error messages (may be NULL) */
+  const sph_neighbors *nl;
+  const sph_kernel *kernel;
+  double rcond_min; /* 0 selects the default 1e-10 */
+} sph_cloud;
+
+/* Per-pair gradients grad[3*k] for every slot k of the CSR list, and (if L is
+ * not NULL) the 9*n correction matrices used (identity for UNCORRECTED and
+ * W1). */
+sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
+                                   double *grad, double *L, sph_error *err);
+
+/* Corrected kernel values: w[k] for slot k (W~_b(X_a)) and wself[a]
+ * (W~_a(X_a)); order 0 gives W~0, order 1 gives W~1. */
+sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
+                                 double *wself, sph_error *err);
+
+/* Corrected Laplacian Lap W~_b(X_a) for every slot (seed 000 App. A). */
+sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
+                                    sph_error *err);
+
+#endif

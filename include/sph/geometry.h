@@ -1,0 +1,28 @@
+/* Geometry generators: shapes as signed distance functions and the particle
+ * lattices that fill them (box, cylinder, ring/annulus, disc, sphere,
+ * spherical shell), with optional jitter and relaxation to an irregular,
+ * uniform distribution. */
+#ifndef SPH_GEOMETRY_H
+#define SPH_GEOMETRY_H
+
+#include <stddef.h>
+
+#include "sph/scene.h"
+#include "sph/status.h"
+
+/* Signed distance from X to the shape's surface (negative inside). 2D shapes
+ * ignore z. */
+double sph_shape_distance(const sph_shape *s, int dim, const double X[3]);
+
+/* Axis-aligned bounding box of the shape. */
+void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]);
+
+/* Exact area (2D) or volume (3D) of the shape. */
+double sph_shape_measure(const sph_shape *s, int dim);
+
+/* Particles of one body: *x (3 per particle) and *v (volumes), malloc'd,
+ * *n of them. Deterministic for a given body (seeded RNG). */
+sph_status sph_body_generate(const sph_body *b, int dim, double **x,
+                             double **volume, size_t *n, sph_error *err);
+
+#endif

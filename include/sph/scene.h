@@ -1,0 +1,210 @@
+/* A validated, typed scene (DESIGN.md sec. 6) and the particles it makes.
+ *
+ * sph_scene_load reads a YAML scene, applies --set overrides, validates
+ * every key (errors name file, line, column and key) and fills defaults.
+ * The method block is kept as a node tree: each method validates its own
+ * options. sph_scene_build_particles generates every body's particles. */
+#ifndef SPH_SCENE_H
+#define SPH_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sph/kernel.h"
+#include "sph/material.h"
+#include "sph/node.h"
+#include "sph/particles.h"
+#include "sph/status.h"
+
+#define SPH_NAME_MAX 64
+
+typedef enum sph_shape_kind {
+  SPH_SHAPE_BOX,      /* min, max */
+  SPH_SHAPE_CYLINDER, /* center (of the base), axis, radius, length */
+  SPH_SHAPE_RING,     /* 2D annulus: center, inner/outer radius; 3D: a tube
+                         along axis with length */
+  SPH_SHAPE_DISC,     /* 2D: center, radius */
+  SPH_SHAPE_SPHERE,   /* 3D: center, radius */
+  SPH_SHAPE_SHELL     /* 3D spherical shell: center, inner/outer radius */
+} sph_shape_kind;
+
+typedef struct sph_shape {
+  sph_shape_kind kind;
+  double min[3], max[3]; /* box */
+  double center[3];
+  int axis; /* 0, 1, 2 = x, y, z */
+  double radius, inner_radius, outer_radius, length;
+} sph_shape;
+
+typedef enum sph_lattice {
+  SPH_LATTICE_FACES,       /* particles on the faces: count [nx,ny,nz] on a
+                              box, dp = L/(n-1), tributary volumes (BENCHMARKS
+                              D.5) */
+  SPH_LATTICE_CELL_CENTRED /* spacing dp, cell centres clipped to the shape,
+                              V = dp^d */
+} sph_lattice;
+
+typedef enum sph_distribution {
+  SPH_DIST_LATTICE,
+  SPH_DIST_JITTER, /* lattice moved by a uniform random offset */
+  SPH_DIST_RELAX   /* lattice jittered then relaxed to a uniform irregular set */
+} sph_distribution;
+
+typedef enum sph_velocity_kind {
+  SPH_VEL_NONE,
+  SPH_VEL_UNIFORM,    /* value */
+  SPH_VEL_ROTATION,   /* v = (omega profile(X)) axis x (X - center) */
+  SPH_VEL_EXPRESSION  /* three expressions of x, y, z (reference coords) */
+} sph_velocity_kind;
+
+typedef struct sph_expr sph_expr; /* see expr.h */
+
+typedef struct sph_velocity {
+  sph_velocity_kind kind;
+  double value[3];
+  int axis;
+  double omega;
+  double center[3];
+  sph_expr *profile;   /* rotation profile, NULL = 1 */
+  sph_expr *expr[3];   /* expression components */
+} sph_velocity;
+
+typedef struct sph_body {
+  char name[SPH_NAME_MAX];
+  int material; /* index into scene->materials */
+  sph_shape shape;
+  sph_lattice lattice;
+  int count[3];   /* SPH_LATTICE_FACES */
+  double spacing; /* dp (derived from count for FACES: the smallest L/(n-1)) */
+  sph_distribution distribution;
+  double jitter;  /* fraction of dp */
+  unsigned long seed;
+  int relax_steps;
+  sph_velocity velocity;
+  int line, col; /* of the body entry */
+} sph_body;
+
+typedef enum sph_select_kind {
+  SPH_SELECT_PLANE, /* |X_axis - at| <= tolerance */
+  SPH_SELECT_BOX,   /* min <= X <= max (inclusive, with tolerance) */
+  SPH_SELECT_FACE   /* the side of a body's bounding box: body, axis, sign */
+} sph_select_kind;
+
+typedef struct sph_selection {
+  sph_select_kind kind;
+  int axis;
+  double at;
+  double tolerance; /* default: half the body spacing */
+  double min[3], max[3];
+  int body; /* -1: all bodies */
+  int side; /* -1 or +1 for FACE */
+} sph_selection;
+
+typedef enum sph_condition_kind {
+  SPH_BC_CLAMP,    /* all velocity components fixed to zero */
+  SPH_BC_ROLLER,   /* normal component fixed to zero (symmetry plane) */
+  SPH_BC_VELOCITY, /* velocity prescribed over [from, until) */
+  SPH_BC_SYMMETRY, /* mirror plane: ghosts reflect positions, negate the
+                      normal velocity component (BENCHMARKS D.1) */
+  SPH_BC_SKEW_SYMMETRY /* mirror plane: ghosts negate the tangential
+                          components */
+} sph_condition_kind;
+
+typedef struct sph_boundary {
+  char name[SPH_NAME_MAX];
+  sph_selection select;
+  sph_condition_kind kind;
+  int axis;         /* roller / symmetry plane normal */
+  double value[3];  /* prescribed velocity */
+  unsigned mask;    /* components prescribed (bits 0..2) */
+  double from, until;
+  int line, col;
+} sph_boundary;
+
+typedef struct sph_probe {
+  char name[SPH_NAME_MAX];
+  double at[3];
+  int fields[8];
+  int nfields;
+  int line, col;
+} sph_probe;
+
+typedef struct sph_camera {
+  int given;
+  double position[3], target[3], up[3];
+  int has_position;
+  double azimuth, elevation, zoom;
+  int orthographic;
+} sph_camera;
+
+typedef struct sph_png_output {
+  int enabled;
+  int width, height;
+  int color_field; /* sph_field */
+  char range_mode[16]; /* auto | symmetric | fixed | global */
+  double range[2];
+  sph_camera camera;
+} sph_png_output;
+
+typedef struct sph_output {
+  double every;
+  int vtk;
+  int vtk_ascii;
+  int fields[SPH_FIELD_COUNT]; /* sph_field list for the sinks */
+  int nfields;
+  int body_id, particle_id; /* integer arrays asked for by name */
+  sph_png_output png;
+  sph_probe *probes;
+  size_t nprobes;
+  double checkpoint_every; /* 0 = off */
+} sph_output;
+
+typedef struct sph_scene {
+  char name[SPH_NAME_MAX];
+  char path[512];
+  int dimension;
+  sph_node *root;   /* the resolved tree (defaults filled) */
+  sph_node *method; /* the method block, validated by the method */
+  sph_node *reference; /* optional `reference:` block (analytic solution or
+                          scalar reference), validated by its user; NULL */
+  char method_name[SPH_NAME_MAX];
+  sph_kernel_type kernel_type;
+  double h_over_dp;
+  sph_material *materials;
+  size_t nmaterials;
+  sph_body *bodies;
+  size_t nbodies;
+  sph_boundary *boundaries;
+  size_t nboundaries;
+  int has_body_force;
+  double body_force[3]; /* acceleration, m/s^2 */
+  double t_end;
+  sph_output output;
+} sph_scene;
+
+/* Loads and validates `path`, after applying `nset` overrides "a.b=value". */
+sph_status sph_scene_load(sph_scene **out, const char *path,
+                          const char *const *overrides, size_t nset,
+                          sph_error *err);
+void sph_scene_destroy(sph_scene *s);
+
+/* Generates the particles of every body (POSITION0, VOLUME0, VELOCITY
+ * allocated and filled; flags marked for boundary selections) and checks
+ * what needs particles: empty bodies, bodies that overlap, boundary
+ * selections that select nothing, probes outside every body. */
+sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
+                                     sph_error *err);
+
+/* Smallest particle spacing over the bodies. */
+double sph_scene_min_spacing(const sph_scene *s);
+
+/* Index of the named material/body, or -1. */
+int sph_scene_find_material(const sph_scene *s, const char *name);
+int sph_scene_find_body(const sph_scene *s, const char *name);
+
+/* Whether boundary `b` selects the particle at reference position X of body
+ * `body`. */
+int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
+                           int body, const double X[3]);
+
+#endif

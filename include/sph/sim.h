@@ -1,0 +1,129 @@
+/* A simulation: the particles a scene makes, the method that advances them
+ * and the terms the scene asked for (DESIGN.md sec. 2 and 4).
+ *
+ * Methods and terms plug in through small run-time ops tables (as SUNDIALS'
+ * N_Vector_Ops): the time loop calls method->stable_dt and method->step once
+ * per step; a method calls its terms' hooks once per stage. Pair
+ * interactions stay static inline inside each method. A term the scene does
+ * not ask for is never created, so it is never allocated, run or timed. */
+#ifndef SPH_SIM_H
+#define SPH_SIM_H
+
+#include <stddef.h>
+
+#include "sph/kernel.h"
+#include "sph/neighbors.h"
+#include "sph/node.h"
+#include "sph/particles.h"
+#include "sph/scene.h"
+#include "sph/status.h"
+
+typedef struct sph_sim sph_sim;
+typedef struct sph_term sph_term;
+
+/* The state a stage works on and the rates it produces (NULL when the method
+ * does not carry the variable). Arrays are per particle, as in particles.h. */
+typedef struct sph_stage {
+  double t;         /* stage time */
+  const double *x;  /* positions (3) */
+  const double *p;  /* linear momentum per reference volume (3) or velocity */
+  const double *F;  /* deformation gradient (9) */
+  const double *H;  /* cofactor (9) */
+  const double *J;  /* Jacobian (1) */
+  const double *x_moment; /* positions about which angular momentum is
+                             balanced at this stage (seed 000 eq. 45) */
+  double *dx, *dp, *dF, *dH, *dJ; /* rates, same layouts */
+} sph_stage;
+
+typedef struct sph_term_ops {
+  const char *name;      /* as printed and in summary.json */
+  const char *reference; /* seed and equations */
+  /* adds its contribution to the stage rates (may be NULL) */
+  sph_status (*rates)(sph_term *term, sph_sim *sim, sph_stage *stage,
+                      sph_error *err);
+  /* corrects the state after an update, e.g. prescribed velocities (may be
+   * NULL); `state` has the same layout as a stage with rates unused */
+  sph_status (*constrain)(sph_term *term, sph_sim *sim, sph_stage *state,
+                          sph_error *err);
+  void (*destroy)(sph_term *term);
+} sph_term_ops;
+
+struct sph_term {
+  const sph_term_ops *ops;
+  void *data;           /* the term's own state */
+  double seconds;       /* wall time spent in its hooks */
+  unsigned long calls;
+};
+
+typedef struct sph_method_ops {
+  const char *name;      /* scene name, e.g. "tl-jst" */
+  const char *title;     /* readable name */
+  const char *reference; /* seed sections and equations */
+  /* validates the method block, requires fields, creates its terms */
+  sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);
+  double (*stable_dt)(sph_sim *sim);
+  sph_status (*step)(sph_sim *sim, double dt, sph_error *err);
+  /* fills the derived output fields (pressure, stress, von Mises, J,
+   * displacement, velocity) from the method's state */
+  sph_status (*derive)(sph_sim *sim, sph_error *err);
+  /* kinetic and stored (strain) energy of the current state */
+  void (*energy)(sph_sim *sim, double *kinetic, double *strain);
+  void (*destroy)(sph_sim *sim);
+} sph_method_ops;
+
+/* Timer slot for a method's own work (internal force etc.). */
+typedef struct sph_timer {
+  const char *name;
+  double seconds;
+  unsigned long calls;
+} sph_timer;
+
+#define SPH_MAX_TERMS 16
+#define SPH_MAX_TIMERS 8
+
+struct sph_sim {
+  const sph_scene *scene;
+  const sph_method_ops *method;
+  void *method_data;
+  sph_particles *ps;
+  sph_kernel kernel;
+  double dp; /* smallest particle spacing */
+  double t;
+  unsigned long steps;
+  double dt_min, dt_max, dt_last;
+  sph_term terms[SPH_MAX_TERMS];
+  int nterms;
+  sph_timer timers[SPH_MAX_TIMERS];
+  int ntimers;
+  int threads;
+};
+
+/* Method table lookup (the registry lists every method once). */
+const sph_method_ops *sph_method_find(const char *name);
+/* NULL-terminated list of every method. */
+const sph_method_ops *const *sph_method_list(void);
+
+/* Builds particles, looks up and sets up the method (its option errors point
+ * into the scene file). */
+sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
+                          sph_error *err);
+void sph_sim_destroy(sph_sim *sim);
+
+/* Advances one step of at most dt_cap (so output times are hit exactly). */
+sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err);
+
+/* Adds a term to the sim (called by methods in setup); the sim owns it. */
+sph_status sph_sim_add_term(sph_sim *sim, const sph_term_ops *ops, void *data,
+                            sph_error *err);
+/* Registers a named timer for method work; returns its index. */
+int sph_sim_add_timer(sph_sim *sim, const char *name);
+
+/* Runs every term's rates / constrain hook in order, timing each. */
+sph_status sph_sim_terms_rates(sph_sim *sim, sph_stage *stage, sph_error *err);
+sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
+                                   sph_error *err);
+
+/* Monotonic wall clock in seconds. */
+double sph_wtime(void);
+
+#endif

@@ -1,0 +1,63 @@
+/* Status codes and the error record every library call fills.
+ *
+ * One X-macro list gives the codes and their messages; the library never
+ * prints or exits, it returns a code and fills an sph_error that only the
+ * command-line front end reports. */
+#ifndef SPH_STATUS_H
+#define SPH_STATUS_H
+
+#include <stddef.h>
+
+#define SPH_STATUS_LIST(X)                                                     \
+  X(SPH_OK, "ok")                                                              \
+  X(SPH_ERR_NOMEM, "out of memory")                                            \
+  X(SPH_ERR_IO, "input/output error")                                          \
+  X(SPH_ERR_ARG, "invalid argument")                                           \
+  X(SPH_ERR_SYNTAX, "syntax error")                                            \
+  X(SPH_ERR_UNKNOWN_KEY, "unknown key")                                        \
+  X(SPH_ERR_DUPLICATE_KEY, "duplicate key")                                    \
+  X(SPH_ERR_TYPE, "wrong type")                                                \
+  X(SPH_ERR_MISSING_KEY, "missing required key")                               \
+  X(SPH_ERR_RANGE, "value out of range")                                       \
+  X(SPH_ERR_GEOMETRY, "invalid geometry")                                      \
+  X(SPH_ERR_SINGULAR, "singular moment matrix")                                \
+  X(SPH_ERR_UNSUPPORTED, "not supported")                                      \
+  X(SPH_ERR_NUMERIC, "non-finite value")
+
+typedef enum sph_status {
+#define SPH_STATUS_ENUM(code, msg) code,
+  SPH_STATUS_LIST(SPH_STATUS_ENUM)
+#undef SPH_STATUS_ENUM
+      SPH_STATUS_COUNT
+} sph_status;
+
+/* Where and why a call failed. `file`, `line`, `col` and `key` locate the
+ * offending input when there is one (line and col are 1-based, 0 = unknown). */
+typedef struct sph_error {
+  sph_status code;
+  char file[256];
+  int line;
+  int col;
+  char key[128];
+  char message[768];
+} sph_error;
+
+const char *sph_status_message(sph_status code);
+const char *sph_status_name(sph_status code);
+
+/* Clears the record (code SPH_OK, empty strings). Accepts NULL. */
+void sph_error_clear(sph_error *err);
+
+/* Fills the record and returns `code`; printf-style message. Accepts NULL. */
+sph_status sph_error_set(sph_error *err, sph_status code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* As sph_error_set, with an input location and key. */
+sph_status sph_error_at(sph_error *err, sph_status code, const char *file,
+                        int line, int col, const char *key, const char *fmt,
+                        ...) __attribute__((format(printf, 7, 8)));
+
+/* Writes "file:line:col: key: message" (parts present only) into buf. */
+void sph_error_format(const sph_error *err, char *buf, size_t size);
+
+#endif

@@ -1,0 +1,43 @@
+/* The sph command: sub-commands and the helpers they share. Only this layer
+ * prints and chooses exit codes (0 success, 1 failed run or comparison,
+ * 2 bad input or usage). */
+#ifndef SPH_APP_IMPL_H
+#define SPH_APP_IMPL_H
+
+#include <stddef.h>
+
+#include "sph/status.h"
+
+#define SPH_EXIT_OK 0
+#define SPH_EXIT_FAIL 1
+#define SPH_EXIT_USAGE 2
+
+#define SPH_MAX_SETS 64
+
+/* Options common to commands that take a scene. */
+typedef struct sph_app_args {
+  const char *scene;              /* path (default scene when NULL) */
+  const char *sets[SPH_MAX_SETS]; /* --set k=v */
+  size_t nsets;
+  const char *out; /* --out DIR */
+  int threads;     /* --threads N (0 = OpenMP default) */
+  int overwrite;   /* --overwrite */
+  int quiet;       /* --quiet */
+} sph_app_args;
+
+/* Parses argv[first..] into args; prints usage errors; returns 0 or 2. */
+int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
+                       const char *command);
+
+/* The shipped scenes folder and the default scene. */
+const char *sph_app_scenes_dir(void);
+const char *sph_app_default_scene(void);
+
+/* Prints "sph: file:line:col: key: message" to stderr. */
+void sph_app_print_error(const sph_error *err);
+
+int sph_cmd_run(int argc, char **argv);
+int sph_cmd_check(int argc, char **argv);
+int sph_cmd_list(int argc, char **argv);
+
+#endif

@@ -1,0 +1,78 @@
+/* sph check: validate a scene, build its particles and method, and print
+ * what a run would simulate (bodies, method, terms, time step, memory). */
+#include <stdio.h>
+#include <sys/resource.h>
+
+#include "app/app_impl.h"
+#include "sph/scene.h"
+#include "sph/sim.h"
+
+static double peak_rss_mib(void) {
+  struct rusage ru;
+  if (getrusage(RUSAGE_SELF, &ru) != 0)
+    return 0.0;
+  return (double)ru.ru_maxrss / 1024.0; /* ru_maxrss is in KiB on Linux */
+}
+
+static void print_plan(const sph_scene *s, sph_sim *sim) {
+  const sph_particles *ps = sim->ps;
+  printf("scene      %s (%s)\n", s->name, s->path);
+  printf("dimension  %d\n", s->dimension);
+  printf("method     %s: %s [%s]\n", sim->method->name, sim->method->title,
+         sim->method->reference);
+  printf("kernel     %s, h = %.4g m (h/dp = %.3g), support %.4g m\n",
+         sph_kernel_type_name(s->kernel_type), sim->kernel.h, s->h_over_dp,
+         sim->kernel.support);
+  printf("bodies     %zu\n", s->nbodies);
+  for (size_t b = 0; b < s->nbodies; ++b) {
+    size_t count = 0;
+    for (size_t i = 0; i < ps->n; ++i)
+      count += ps->body[i] == (int32_t)b;
+    const sph_body *body = &s->bodies[b];
+    printf("  %-16s %8zu particles, dp = %.4g m, material %s (%s)\n",
+           body->name, count, body->spacing, s->materials[body->material].name,
+           s->materials[body->material].ops->name);
+  }
+  printf("particles  %zu\n", ps->n);
+  printf("terms      %d\n", sim->nterms);
+  for (int i = 0; i < sim->nterms; ++i)
+    printf("  %-32s [%s]\n", sim->terms[i].ops->name,
+           sim->terms[i].ops->reference);
+  double dt = sim->method->stable_dt(sim);
+  double steps = dt > 0.0 ? s->t_end / dt : 0.0;
+  printf("time       end %.6g s, first dt %.4g s, about %.0f steps\n", s->t_end,
+         dt, steps);
+  printf("outputs    every %.6g s (%.0f frames)\n", s->output.every,
+         s->t_end / s->output.every + 1.0);
+  printf("memory     %.1f MiB peak resident after set-up (fields %.1f MiB)\n",
+         peak_rss_mib(), (double)sph_particles_bytes(ps) / 1048576.0);
+}
+
+int sph_cmd_check(int argc, char **argv) {
+  sph_app_args args;
+  int rc = sph_app_parse_args(argc, argv, 2, &args, "check");
+  if (rc != SPH_EXIT_OK)
+    return rc;
+  if (!args.scene) {
+    fprintf(stderr, "sph check: which scene? (usage: sph check SCENE "
+                    "[--set k=v]...)\n");
+    return SPH_EXIT_USAGE;
+  }
+  sph_error err;
+  sph_error_clear(&err);
+  sph_scene *scene = NULL;
+  sph_sim *sim = NULL;
+  sph_status st =
+      sph_scene_load(&scene, args.scene, args.sets, args.nsets, &err);
+  if (st == SPH_OK)
+    st = sph_sim_create(&sim, scene, &err);
+  if (st != SPH_OK) {
+    sph_app_print_error(&err);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
+  print_plan(scene, sim);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(scene);
+  return SPH_EXIT_OK;
+}

@@ -1,0 +1,112 @@
+/* sph: a headless simulator for large-strain elastic solid dynamics with
+ * SPH. Dispatches to the sub-commands (DESIGN.md sec. 1). */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "app/app_impl.h"
+
+static void usage(FILE *out) {
+  fprintf(out, "usage: sph <command> [options]\n"
+               "\n"
+               "commands:\n"
+               "  run [SCENE] [--set k=v]... [--out DIR] [--threads N] "
+               "[--overwrite] [--quiet]\n"
+               "                       simulate a scene (default: the twisting "
+               "column)\n"
+               "  check SCENE [--set k=v]...\n"
+               "                       validate a scene and print what will be "
+               "simulated\n"
+               "  list                 list the shipped scenes\n"
+               "  help                 this text\n");
+}
+
+const char *sph_app_scenes_dir(void) {
+  const char *env = getenv("SPH_SCENES_DIR");
+  return env && *env ? env : SPH_SOURCE_DIR "/scenes";
+}
+
+const char *sph_app_default_scene(void) {
+  static char path[1024];
+  snprintf(path, sizeof path, "%s/twisting_column.yaml", sph_app_scenes_dir());
+  return path;
+}
+
+void sph_app_print_error(const sph_error *err) {
+  char buf[2048];
+  sph_error_format(err, buf, sizeof buf);
+  fprintf(stderr, "sph: %s\n", buf);
+}
+
+int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
+                       const char *command) {
+  memset(args, 0, sizeof *args);
+  for (int i = first; i < argc; ++i) {
+    const char *a = argv[i];
+    const char *val = NULL;
+    int takes =
+        !strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--threads");
+    if (takes) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "sph %s: %s needs a value\n", command, a);
+        return SPH_EXIT_USAGE;
+      }
+      val = argv[++i];
+    }
+    if (!strcmp(a, "--set")) {
+      if (args->nsets >= SPH_MAX_SETS) {
+        fprintf(stderr, "sph %s: more than %d --set options\n", command,
+                SPH_MAX_SETS);
+        return SPH_EXIT_USAGE;
+      }
+      args->sets[args->nsets++] = val;
+    } else if (!strcmp(a, "--out")) {
+      args->out = val;
+    } else if (!strcmp(a, "--threads")) {
+      char *end;
+      long n = strtol(val, &end, 10);
+      if (*end || n < 1 || n > 1024) {
+        fprintf(stderr, "sph %s: --threads takes a count from 1 to 1024\n",
+                command);
+        return SPH_EXIT_USAGE;
+      }
+      args->threads = (int)n;
+    } else if (!strcmp(a, "--overwrite")) {
+      args->overwrite = 1;
+    } else if (!strcmp(a, "--quiet")) {
+      args->quiet = 1;
+    } else if (a[0] == '-' && a[1] == '-') {
+      fprintf(stderr, "sph %s: unknown option %s\n", command, a);
+      return SPH_EXIT_USAGE;
+    } else if (!args->scene) {
+      args->scene = a;
+    } else {
+      fprintf(stderr, "sph %s: more than one scene given (%s, %s)\n", command,
+              args->scene, a);
+      return SPH_EXIT_USAGE;
+    }
+  }
+  if (args->threads > 0)
+    omp_set_num_threads(args->threads);
+  return SPH_EXIT_OK;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2)
+    return sph_cmd_run(argc, argv);
+  const char *cmd = argv[1];
+  if (!strcmp(cmd, "run"))
+    return sph_cmd_run(argc, argv);
+  if (!strcmp(cmd, "check"))
+    return sph_cmd_check(argc, argv);
+  if (!strcmp(cmd, "list"))
+    return sph_cmd_list(argc, argv);
+  if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
+    usage(stdout);
+    return SPH_EXIT_OK;
+  }
+  fprintf(stderr, "sph: unknown command '%s'\n\n", cmd);
+  usage(stderr);
+  return SPH_EXIT_USAGE;
+}

@@ -1,0 +1,11 @@
+/* Ops tables of the methods (each defined in its own folder). */
+#ifndef SPH_REGISTRY_IMPL_H
+#define SPH_REGISTRY_IMPL_H
+
+#include <string.h>
+
+#include "sph/sim.h"
+
+extern const sph_method_ops tl_jst_method_ops;
+
+#endif
