@@ -73,8 +73,9 @@ sph_status sph_node_get_bool(sph_node *map, const char *key, int required,
 sph_status sph_node_get_string(sph_node *map, const char *key, int required,
                                const char *def, const char **out,
                                sph_error *err);
-/* A sequence of exactly n numbers (n = 0: any length up to max, count in
- * *got). */
+/* A sequence of exactly n numbers; with n = 0 any length up to *got on
+ * entry (the capacity of out). *got (if not NULL) receives the count; an
+ * absent optional key gives count 0. */
 sph_status sph_node_get_doubles(sph_node *map, const char *key, int required,
                                 size_t n, double *out, size_t *got,
                                 sph_error *err);
