@@ -1,7 +1,8 @@
 /* Expressions of the reference coordinates x, y, z (and t) in scene files,
  * e.g. a twist profile "sin(pi*y/(2*6))". Parsed and evaluated by GNU
- * libmatheval (Debian libmatheval-dev). Parsing is not thread-safe: create
- * expressions while loading, evaluate anywhere. */
+ * libmatheval (Debian libmatheval-dev). Neither parsing nor evaluation is
+ * thread-safe (an evaluator stores the variable values it is given): create
+ * and evaluate expressions from one thread, e.g. while generating bodies. */
 #ifndef SPH_EXPR_H
 #define SPH_EXPR_H
 
