@@ -53,11 +53,14 @@ typedef struct sph_cloud {
   double rcond_min; /* 0 selects the default 1e-10 */
 } sph_cloud;
 
-/* Per-pair gradients grad[3*k] for every slot k of the CSR list, and (if L is
- * not NULL) the 9*n correction matrices used (identity for UNCORRECTED and
- * W1). */
+/* Per-pair gradients grad[3*k] for every slot k of the CSR list; if not
+ * NULL, grad_self[3*a] receives the gradient of the particle's own kernel
+ * at itself (nonzero only for W1, where sum_b V_b f_b grad W~1_b(x_a) over b
+ * including a reproduces linear gradients), and L[9*a] the correction
+ * matrices used (identity for UNCORRECTED and W1). */
 sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
-                                   double *grad, double *L, sph_error *err);
+                                   double *grad, double *grad_self, double *L,
+                                   sph_error *err);
 
 /* Corrected kernel values: w[k] for slot k (W~_b(X_a)) and wself[a]
  * (W~_a(X_a)); order 0 gives W~0, order 1 gives W~1. */

@@ -83,6 +83,13 @@ sph_status sph_node_get_doubles(sph_node *map, const char *key, int required,
 sph_status sph_node_get_map(sph_node *map, const char *key, int required,
                             sph_node **out, sph_error *err);
 
+/* Inserts `yaml` (parsed as YAML, e.g. "{}" or "[a, b]") under `key` as a
+ * default (it takes the map's origin) and returns it in *out; when the key
+ * exists, returns the existing child instead. */
+sph_status sph_node_insert_default(sph_node *map, const char *key,
+                                   const char *yaml, sph_node **out,
+                                   sph_error *err);
+
 /* Scalar conversions of a single node. */
 sph_status sph_node_as_double(const sph_node *n, double *out, sph_error *err);
 sph_status sph_node_as_int(const sph_node *n, long *out, sph_error *err);

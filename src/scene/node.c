@@ -64,7 +64,7 @@ static int node_append(sph_node *parent, const char *key, sph_node *child) {
     if (!keys)
       return -1;
     parent->keys = keys;
-    keys[c - 1] = strdup(key);
+    keys[c - 1] = strdup(key ? key : "");
     if (!keys[c - 1])
       return -1;
   }

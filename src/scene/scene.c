@@ -1,1 +1,1136 @@
-/* placeholder: being written */
+/* The scene schema (DESIGN.md sec. 6): every key of a YAML scene checked,
+ * typed and defaulted, with errors at the file, line, column and key; and
+ * the particles the bodies make, with the checks that need them (empty or
+ * overlapping bodies, selections that select nothing, probes outside every
+ * body). The method and reference blocks are left to their users. */
+#include "sph/scene.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sph/expr.h"
+#include "sph/geometry.h"
+#include "sph/neighbors.h"
+
+#define TRY(expr)                                                              \
+  do {                                                                         \
+    sph_status st_ = (expr);                                                   \
+    if (st_ != SPH_OK)                                                         \
+      return st_;                                                              \
+  } while (0)
+
+static const char *const axis_names[] = {"x", "y", "z", NULL};
+
+/* ---- small readers
+ * ----------------------------------------------------------- */
+
+static sph_status get_seq(sph_node *map, const char *key, int required,
+                          sph_node **out, sph_error *err) {
+  *out = sph_node_child(map, key);
+  if (!*out) {
+    if (!required)
+      return SPH_OK;
+    char path[256];
+    snprintf(path, sizeof path, "%s%s%s", map->path, *map->path ? "." : "",
+             key);
+    return sph_error_at(err, SPH_ERR_MISSING_KEY, map->file, map->line,
+                        map->col, path, "missing required key '%s'", key);
+  }
+  (*out)->used = 1;
+  if ((*out)->kind != SPH_NODE_SEQ)
+    return sph_node_error(*out, err, SPH_ERR_TYPE,
+                          "expected a sequence (a list with '-' items)");
+  return SPH_OK;
+}
+
+static sph_status get_axis(sph_node *map, const char *key, int required,
+                           int def, int *out, sph_error *err) {
+  const char *name;
+  TRY(sph_node_get_string(map, key, required, axis_names[def], &name, err));
+  for (int a = 0; a < 3; ++a)
+    if (!strcmp(name, axis_names[a])) {
+      *out = a;
+      return SPH_OK;
+    }
+  return sph_node_error(sph_node_child(map, key), err, SPH_ERR_RANGE,
+                        "axis must be x, y or z, got '%s'", name);
+}
+
+static sph_status positive(sph_node *map, const char *key, int required,
+                           double def, double *out, sph_error *err) {
+  TRY(sph_node_get_double(map, key, required, def, out, err));
+  if (!(*out > 0.0))
+    return sph_node_error(sph_node_child(map, key), err, SPH_ERR_RANGE,
+                          "must be positive, got %g", *out);
+  return SPH_OK;
+}
+
+/* The one key of `map` among `choices`; errors when none or several. */
+static sph_status one_of(sph_node *map, const char *const *choices,
+                         const char *what, int *which, sph_error *err) {
+  *which = -1;
+  char list[256] = "";
+  for (int i = 0; choices[i]; ++i) {
+    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+    strncat(list, choices[i], sizeof list - strlen(list) - 1);
+    if (!sph_node_child(map, choices[i]))
+      continue;
+    if (*which >= 0)
+      return sph_node_error(sph_node_child(map, choices[i]), err, SPH_ERR_ARG,
+                            "give only one %s: '%s' and '%s'", what,
+                            choices[*which], choices[i]);
+    *which = i;
+  }
+  if (*which < 0)
+    return sph_node_error(map, err, SPH_ERR_MISSING_KEY, "give one %s (%s)",
+                          what, list);
+  return SPH_OK;
+}
+
+static void copy_name(char *dst, const char *src) {
+  snprintf(dst, SPH_NAME_MAX, "%s", src);
+}
+
+/* ---- sections --------------------------------------------------------------
+ */
+
+static sph_status parse_kernel(sph_scene *s, sph_node *root, sph_error *err) {
+  sph_node *k;
+  TRY(sph_node_insert_default(root, "kernel", "{}", &k, err));
+  if (k->kind != SPH_NODE_MAP)
+    return sph_node_error(k, err, SPH_ERR_TYPE, "expected a mapping");
+  static const char *const keys[] = {"type", "h_over_dp", NULL};
+  TRY(sph_node_check_keys(k, keys, err));
+  const char *type;
+  TRY(sph_node_get_string(k, "type", 0, "cubic", &type, err));
+  int t = sph_kernel_type_from_name(type);
+  if (t < 0)
+    return sph_node_error(sph_node_child(k, "type"), err, SPH_ERR_RANGE,
+                          "unknown kernel '%s' (known: cubic, quintic, "
+                          "wendland-c2, wendland-c4)",
+                          type);
+  s->kernel_type = (sph_kernel_type)t;
+  TRY(sph_node_get_double(k, "h_over_dp", 0, 1.3, &s->h_over_dp, err));
+  if (!(s->h_over_dp >= 0.8 && s->h_over_dp <= 4.0))
+    return sph_node_error(sph_node_child(k, "h_over_dp"), err, SPH_ERR_RANGE,
+                          "must be in [0.8, 4], got %g", s->h_over_dp);
+  return SPH_OK;
+}
+
+static sph_status parse_material(sph_material *m, const char *name, sph_node *n,
+                                 sph_error *err) {
+  if (n->kind != SPH_NODE_MAP)
+    return sph_node_error(n, err, SPH_ERR_TYPE,
+                          "expected a mapping of material parameters");
+  static const char *const keys[] = {"model",
+                                     "density",
+                                     "youngs_modulus",
+                                     "poisson_ratio",
+                                     "shear_modulus",
+                                     "bulk_modulus",
+                                     "xi",
+                                     NULL};
+  TRY(sph_node_check_keys(n, keys, err));
+  sph_material_params p = {0};
+  TRY(sph_node_get_string(n, "model", 0, "neo-hookean", &p.model, err));
+  int known = 0;
+  for (const char *const *mname = sph_material_models(); *mname; ++mname)
+    known |= !strcmp(*mname, p.model);
+  if (!known) {
+    const char *hint = sph_suggest(p.model, sph_material_models());
+    return sph_node_error(sph_node_child(n, "model"), err, SPH_ERR_RANGE,
+                          "unknown model '%s'%s%s%s", p.model,
+                          hint ? "; did you mean '"
+                               : " (known: linear-"
+                                 "elastic, neo-hookean, "
+                                 "mooney-rivlin)",
+                          hint ? hint : "", hint ? "'?" : "");
+  }
+  TRY(positive(n, "density", 1, 0, &p.density, err));
+  p.has_youngs =
+      sph_node_child(n, "youngs_modulus") || sph_node_child(n, "poisson_ratio");
+  p.has_moduli =
+      sph_node_child(n, "shear_modulus") || sph_node_child(n, "bulk_modulus");
+  if (p.has_youngs && p.has_moduli)
+    return sph_node_error(n, err, SPH_ERR_ARG,
+                          "give youngs_modulus and poisson_ratio, or "
+                          "shear_modulus and bulk_modulus, not both");
+  if (!p.has_youngs && !p.has_moduli)
+    return sph_node_error(n, err, SPH_ERR_MISSING_KEY,
+                          "give youngs_modulus and poisson_ratio (or "
+                          "shear_modulus and bulk_modulus)");
+  if (p.has_youngs) {
+    TRY(positive(n, "youngs_modulus", 1, 0, &p.youngs_modulus, err));
+    TRY(sph_node_get_double(n, "poisson_ratio", 1, 0, &p.poisson_ratio, err));
+    if (!(p.poisson_ratio > -1.0 && p.poisson_ratio < 0.5))
+      return sph_node_error(sph_node_child(n, "poisson_ratio"), err,
+                            SPH_ERR_RANGE, "must be in (-1, 0.5), got %g",
+                            p.poisson_ratio);
+  } else {
+    TRY(positive(n, "shear_modulus", 1, 0, &p.shear_modulus, err));
+    TRY(positive(n, "bulk_modulus", 1, 0, &p.bulk_modulus, err));
+  }
+  if (sph_node_child(n, "xi")) {
+    p.has_xi = 1;
+    TRY(sph_node_get_double(n, "xi", 1, 0, &p.xi, err));
+  }
+  sph_status st = sph_material_create(m, &p, err);
+  if (st != SPH_OK) {
+    sph_node *at = sph_node_child(n, "xi") ? sph_node_child(n, "xi") : n;
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(at, err, st, "%s", msg);
+  }
+  copy_name(m->name, name);
+  return SPH_OK;
+}
+
+static sph_status parse_materials(sph_scene *s, sph_node *root,
+                                  sph_error *err) {
+  sph_node *mats;
+  TRY(sph_node_get_map(root, "materials", 1, &mats, err));
+  if (mats->count == 0)
+    return sph_node_error(mats, err, SPH_ERR_MISSING_KEY,
+                          "define at least one material");
+  s->materials = calloc(mats->count, sizeof *s->materials);
+  if (!s->materials)
+    return sph_error_set(err, SPH_ERR_NOMEM, "materials");
+  for (size_t i = 0; i < mats->count; ++i) {
+    TRY(parse_material(&s->materials[i], mats->keys[i], mats->items[i], err));
+    mats->items[i]->used = 1;
+    s->nmaterials++;
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
+                              sph_error *err) {
+  static const char *const kinds[] = {"box",    "cylinder", "ring", "disc",
+                                      "sphere", "shell",    NULL};
+  if (n->kind != SPH_NODE_MAP)
+    return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
+  TRY(sph_node_check_keys(n, kinds, err));
+  int which;
+  TRY(one_of(n, kinds, "shape", &which, err));
+  static const sph_shape_kind map[] = {SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER,
+                                       SPH_SHAPE_RING,   SPH_SHAPE_DISC,
+                                       SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL};
+  memset(sh, 0, sizeof *sh);
+  sh->kind = map[which];
+  sph_node *g;
+  TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
+  int d = s->dimension;
+  switch (sh->kind) {
+  case SPH_SHAPE_BOX: {
+    static const char *const keys[] = {"min", "max", NULL};
+    TRY(sph_node_check_keys(g, keys, err));
+    TRY(sph_node_get_doubles(g, "min", 1, (size_t)d, sh->min, NULL, err));
+    TRY(sph_node_get_doubles(g, "max", 1, (size_t)d, sh->max, NULL, err));
+    for (int c = 0; c < d; ++c)
+      if (!(sh->max[c] > sh->min[c]))
+        return sph_node_error(sph_node_child(g, "max"), err, SPH_ERR_GEOMETRY,
+                              "empty box: max must exceed min on every axis "
+                              "(axis %s: %g <= %g)",
+                              axis_names[c], sh->max[c], sh->min[c]);
+    break;
+  }
+  case SPH_SHAPE_DISC:
+  case SPH_SHAPE_SPHERE: {
+    static const char *const keys[] = {"center", "radius", NULL};
+    TRY(sph_node_check_keys(g, keys, err));
+    TRY(sph_node_get_doubles(g, "center", 1, (size_t)d, sh->center, NULL, err));
+    sph_node *r = sph_node_child(g, "radius");
+    TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
+    if (!(sh->radius > 0))
+      return sph_node_error(r, err, SPH_ERR_GEOMETRY,
+                            "empty shape: radius must be positive, got %g",
+                            sh->radius);
+    break;
+  }
+  case SPH_SHAPE_CYLINDER: {
+    static const char *const keys[] = {"center", "axis", "radius", "length",
+                                       NULL};
+    TRY(sph_node_check_keys(g, keys, err));
+    TRY(sph_node_get_doubles(g, "center", 1, 3, sh->center, NULL, err));
+    TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
+    TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
+    if (!(sh->radius > 0))
+      return sph_node_error(sph_node_child(g, "radius"), err, SPH_ERR_GEOMETRY,
+                            "empty shape: radius must be positive, got %g",
+                            sh->radius);
+    TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
+    if (!(sh->length > 0))
+      return sph_node_error(sph_node_child(g, "length"), err, SPH_ERR_GEOMETRY,
+                            "empty shape: length must be positive, got %g",
+                            sh->length);
+    break;
+  }
+  case SPH_SHAPE_RING:
+  case SPH_SHAPE_SHELL: {
+    int tube = sh->kind == SPH_SHAPE_RING && d == 3;
+    static const char *const keys2[] = {"center", "inner_radius",
+                                        "outer_radius", NULL};
+    static const char *const keys3[] = {
+        "center", "inner_radius", "outer_radius", "axis", "length", NULL};
+    TRY(sph_node_check_keys(g, tube ? keys3 : keys2, err));
+    TRY(sph_node_get_doubles(g, "center", 1, tube ? 3 : (size_t)d, sh->center,
+                             NULL, err));
+    TRY(sph_node_get_double(g, "inner_radius", 1, 0, &sh->inner_radius, err));
+    TRY(sph_node_get_double(g, "outer_radius", 1, 0, &sh->outer_radius, err));
+    if (!(sh->inner_radius >= 0 && sh->outer_radius > sh->inner_radius))
+      return sph_node_error(sph_node_child(g, "outer_radius"), err,
+                            SPH_ERR_GEOMETRY,
+                            "empty shape: need 0 <= inner_radius < "
+                            "outer_radius, got %g and %g",
+                            sh->inner_radius, sh->outer_radius);
+    if (tube) {
+      TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
+      TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
+      if (!(sh->length > 0))
+        return sph_node_error(
+            sph_node_child(g, "length"), err, SPH_ERR_GEOMETRY,
+            "empty shape: length must be positive, got %g", sh->length);
+    }
+    break;
+  }
+  }
+  int is3d = sh->kind == SPH_SHAPE_SPHERE || sh->kind == SPH_SHAPE_SHELL ||
+             sh->kind == SPH_SHAPE_CYLINDER;
+  if ((d == 2 && is3d) || (d == 3 && sh->kind == SPH_SHAPE_DISC))
+    return sph_node_error(sph_node_child(n, kinds[which]), err,
+                          SPH_ERR_GEOMETRY,
+                          "a %s does not exist in %dD (2D: box, disc, ring; "
+                          "3D: box, cylinder, ring, sphere, shell)",
+                          kinds[which], d);
+  return SPH_OK;
+}
+
+static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
+                                  sph_error *err) {
+  static const char *const keys[] = {"count",  "spacing", "distribution",
+                                     "jitter", "seed",    "relax_steps",
+                                     NULL};
+  TRY(sph_node_check_keys(n, keys, err));
+  static const char *const how[] = {"count", "spacing", NULL};
+  int which;
+  TRY(one_of(n, how, "of count or spacing", &which, err));
+  int d = s->dimension;
+  if (which == 0) {
+    if (b->shape.kind != SPH_SHAPE_BOX)
+      return sph_node_error(sph_node_child(n, "count"), err, SPH_ERR_ARG,
+                            "particle counts apply to boxes; give a spacing "
+                            "for other shapes");
+    double c[3];
+    TRY(sph_node_get_doubles(n, "count", 1, (size_t)d, c, NULL, err));
+    b->lattice = SPH_LATTICE_FACES;
+    b->spacing = INFINITY;
+    for (int k = 0; k < d; ++k) {
+      if (c[k] != floor(c[k]) || c[k] < 2 || c[k] > 1e6)
+        return sph_node_error(sph_node_child(n, "count"), err, SPH_ERR_RANGE,
+                              "counts must be whole numbers from 2 to 1e6, "
+                              "got %g",
+                              c[k]);
+      b->count[k] = (int)c[k];
+      double h = (b->shape.max[k] - b->shape.min[k]) / (c[k] - 1);
+      b->spacing = h < b->spacing ? h : b->spacing;
+    }
+  } else {
+    b->lattice = SPH_LATTICE_CELL_CENTRED;
+    TRY(positive(n, "spacing", 1, 0, &b->spacing, err));
+  }
+  static const char *const dists[] = {"lattice", "jitter", "relax", NULL};
+  const char *dist;
+  TRY(sph_node_get_string(n, "distribution", 0, "lattice", &dist, err));
+  int dk = -1;
+  for (int i = 0; dists[i]; ++i)
+    if (!strcmp(dist, dists[i]))
+      dk = i;
+  if (dk < 0)
+    return sph_node_error(sph_node_child(n, "distribution"), err, SPH_ERR_RANGE,
+                          "distribution must be lattice, jitter or relax, got "
+                          "'%s'",
+                          dist);
+  b->distribution = (sph_distribution)dk;
+  if (dk != SPH_DIST_LATTICE) {
+    TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
+    if (!(b->jitter >= 0.0 && b->jitter < 0.5))
+      return sph_node_error(sph_node_child(n, "jitter"), err, SPH_ERR_RANGE,
+                            "jitter is a fraction of the spacing in [0, 0.5), "
+                            "got %g",
+                            b->jitter);
+    long seed, steps = 0;
+    TRY(sph_node_get_int(n, "seed", 0, 1, &seed, err));
+    if (seed < 0)
+      return sph_node_error(sph_node_child(n, "seed"), err, SPH_ERR_RANGE,
+                            "seed must be >= 0");
+    b->seed = (unsigned long)seed;
+    if (dk == SPH_DIST_RELAX) {
+      TRY(sph_node_get_int(n, "relax_steps", 0, 100, &steps, err));
+      if (steps < 0 || steps > 100000)
+        return sph_node_error(sph_node_child(n, "relax_steps"), err,
+                              SPH_ERR_RANGE,
+                              "relax_steps must be in [0, "
+                              "100000]");
+    }
+    b->relax_steps = (int)steps;
+  }
+  return SPH_OK;
+}
+
+static sph_status make_expr(sph_node *n, sph_expr **out, sph_error *err) {
+  if (n->kind != SPH_NODE_SCALAR)
+    return sph_node_error(n, err, SPH_ERR_TYPE, "expected an expression");
+  sph_status st = sph_expr_create(out, n->value, err);
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(n, err, st, "%s", msg);
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_velocity(sph_scene *s, sph_velocity *v, sph_node *n,
+                                 sph_error *err) {
+  static const char *const kinds[] = {"uniform", "rotation", "expression",
+                                      NULL};
+  if (n->kind != SPH_NODE_MAP)
+    return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
+  TRY(sph_node_check_keys(n, kinds, err));
+  int which;
+  TRY(one_of(n, kinds, "initial velocity", &which, err));
+  if (which == 0) {
+    v->kind = SPH_VEL_UNIFORM;
+    TRY(sph_node_get_doubles(n, "uniform", 1, 3, v->value, NULL, err));
+  } else if (which == 1) {
+    v->kind = SPH_VEL_ROTATION;
+    sph_node *r;
+    TRY(sph_node_get_map(n, "rotation", 1, &r, err));
+    static const char *const keys[] = {"axis", "omega", "center", "profile",
+                                       NULL};
+    TRY(sph_node_check_keys(r, keys, err));
+    TRY(get_axis(r, "axis", 1, 2, &v->axis, err));
+    TRY(sph_node_get_double(r, "omega", 1, 0, &v->omega, err));
+    if (sph_node_child(r, "center"))
+      TRY(sph_node_get_doubles(r, "center", 1, 3, v->center, NULL, err));
+    else
+      TRY(sph_node_insert_default(r, "center", "[0, 0, 0]", &(sph_node *){0},
+                                  err));
+    sph_node *p = sph_node_child(r, "profile");
+    if (p) {
+      p->used = 1;
+      TRY(make_expr(p, &v->profile, err));
+    }
+  } else {
+    v->kind = SPH_VEL_EXPRESSION;
+    sph_node *e;
+    TRY(get_seq(n, "expression", 1, &e, err));
+    if (e->count != 3)
+      return sph_node_error(e, err, SPH_ERR_TYPE,
+                            "expected three expressions (vx, vy, vz), got %zu",
+                            e->count);
+    for (int c = 0; c < 3; ++c)
+      TRY(make_expr(e->items[c], &v->expr[c], err));
+  }
+  (void)s;
+  return SPH_OK;
+}
+
+static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
+  sph_node *list;
+  TRY(get_seq(root, "bodies", 1, &list, err));
+  if (list->count == 0)
+    return sph_node_error(list, err, SPH_ERR_MISSING_KEY,
+                          "define at least one body");
+  s->bodies = calloc(list->count, sizeof *s->bodies);
+  if (!s->bodies)
+    return sph_error_set(err, SPH_ERR_NOMEM, "bodies");
+  static const char *const keys[] = {"name",      "material",         "shape",
+                                     "particles", "initial_velocity", NULL};
+  for (size_t i = 0; i < list->count; ++i) {
+    sph_node *n = list->items[i];
+    sph_body *b = &s->bodies[i];
+    s->nbodies++;
+    if (n->kind != SPH_NODE_MAP)
+      return sph_node_error(n, err, SPH_ERR_TYPE,
+                            "expected a body (a mapping)");
+    TRY(sph_node_check_keys(n, keys, err));
+    b->line = n->line;
+    b->col = n->col;
+    const char *name, *mat;
+    TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    copy_name(b->name, name);
+    for (size_t j = 0; j < i; ++j)
+      if (!strcmp(s->bodies[j].name, name))
+        return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_ARG,
+                              "two bodies are named '%s'", name);
+    TRY(sph_node_get_string(n, "material", 1, NULL, &mat, err));
+    b->material = sph_scene_find_material(s, mat);
+    if (b->material < 0) {
+      const char *names[64];
+      size_t k = 0;
+      for (; k < s->nmaterials && k < 63; ++k)
+        names[k] = s->materials[k].name;
+      names[k] = NULL;
+      const char *hint = sph_suggest(mat, names);
+      return sph_node_error(sph_node_child(n, "material"), err, SPH_ERR_ARG,
+                            "no material named '%s'%s%s%s", mat,
+                            hint ? "; did you mean '" : "", hint ? hint : "",
+                            hint ? "'?" : "");
+    }
+    sph_node *shape, *parts, *vel;
+    TRY(sph_node_get_map(n, "shape", 1, &shape, err));
+    TRY(parse_shape(s, &b->shape, shape, err));
+    TRY(sph_node_get_map(n, "particles", 1, &parts, err));
+    TRY(parse_particles(s, b, parts, err));
+    TRY(sph_node_get_map(n, "initial_velocity", 0, &vel, err));
+    if (vel)
+      TRY(parse_velocity(s, &b->velocity, vel, err));
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
+                                  sph_error *err) {
+  static const char *const kinds[] = {"plane", "box", "face", NULL};
+  TRY(sph_node_check_keys(n, kinds, err));
+  int which;
+  TRY(one_of(n, kinds, "selection", &which, err));
+  sph_node *g;
+  TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
+  sel->body = -1;
+  sel->kind = (sph_select_kind)which;
+  const char *body = NULL;
+  if (which == SPH_SELECT_FACE) {
+    static const char *const keys[] = {"body", "side", NULL};
+    TRY(sph_node_check_keys(g, keys, err));
+    TRY(sph_node_get_string(g, "body", 1, NULL, &body, err));
+    const char *side;
+    TRY(sph_node_get_string(g, "side", 1, NULL, &side, err));
+    int ok = strlen(side) == 2 && (side[1] == '-' || side[1] == '+');
+    int a = ok ? side[0] - 'x' : -1;
+    if (a < 0 || a > s->dimension - 1)
+      return sph_node_error(sph_node_child(g, "side"), err, SPH_ERR_RANGE,
+                            "side must be one of x-, x+, y-, y+%s, got '%s'",
+                            s->dimension == 3 ? ", z-, z+" : "", side);
+    sel->axis = a;
+    sel->side = side[1] == '+' ? 1 : -1;
+  } else {
+    static const char *const pkeys[] = {"axis", "at", "tolerance", "body",
+                                        NULL};
+    static const char *const bkeys[] = {"min", "max", "body", NULL};
+    TRY(sph_node_check_keys(g, which == 0 ? pkeys : bkeys, err));
+    TRY(sph_node_get_string(g, "body", 0, NULL, &body, err));
+    if (which == SPH_SELECT_PLANE) {
+      TRY(get_axis(g, "axis", 1, 0, &sel->axis, err));
+      TRY(sph_node_get_double(g, "at", 1, 0, &sel->at, err));
+      sel->tolerance = -1.0; /* resolved below */
+      if (sph_node_child(g, "tolerance"))
+        TRY(positive(g, "tolerance", 1, 0, &sel->tolerance, err));
+    } else {
+      int d = s->dimension;
+      TRY(sph_node_get_doubles(g, "min", 1, (size_t)d, sel->min, NULL, err));
+      TRY(sph_node_get_doubles(g, "max", 1, (size_t)d, sel->max, NULL, err));
+      for (int c = 0; c < d; ++c)
+        if (sel->max[c] < sel->min[c])
+          return sph_node_error(sph_node_child(g, "max"), err, SPH_ERR_GEOMETRY,
+                                "empty selection box: max < min on axis %s",
+                                axis_names[c]);
+    }
+  }
+  if (body) {
+    sel->body = sph_scene_find_body(s, body);
+    if (sel->body < 0)
+      return sph_node_error(sph_node_child(g, "body"), err, SPH_ERR_ARG,
+                            "no body named '%s'", body);
+  }
+  double spacing =
+      sel->body >= 0 ? s->bodies[sel->body].spacing : sph_scene_min_spacing(s);
+  if (sel->kind == SPH_SELECT_PLANE && sel->tolerance < 0.0) {
+    char buf[40];
+    snprintf(buf, sizeof buf, "%.6g", 0.5 * spacing);
+    sel->tolerance = strtod(buf, NULL);
+    TRY(sph_node_insert_default(g, "tolerance", buf, &(sph_node *){0}, err));
+  } else if (sel->kind != SPH_SELECT_PLANE) {
+    sel->tolerance = 1e-9 * spacing;
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_boundaries(sph_scene *s, sph_node *root,
+                                   sph_error *err) {
+  sph_node *list;
+  TRY(get_seq(root, "boundaries", 0, &list, err));
+  if (!list)
+    return SPH_OK;
+  s->boundaries = calloc(list->count ? list->count : 1, sizeof *s->boundaries);
+  if (!s->boundaries)
+    return sph_error_set(err, SPH_ERR_NOMEM, "boundaries");
+  static const char *const keys[] = {"name",     "select",   "clamp",
+                                     "roller",   "symmetry", "skew_symmetry",
+                                     "velocity", NULL};
+  static const char *const conds[] = {"clamp",    "roller",        "velocity",
+                                      "symmetry", "skew_symmetry", NULL};
+  for (size_t i = 0; i < list->count; ++i) {
+    sph_node *n = list->items[i];
+    sph_boundary *b = &s->boundaries[i];
+    s->nboundaries++;
+    if (n->kind != SPH_NODE_MAP)
+      return sph_node_error(n, err, SPH_ERR_TYPE,
+                            "expected a boundary condition (a mapping)");
+    TRY(sph_node_check_keys(n, keys, err));
+    b->line = n->line;
+    b->col = n->col;
+    const char *name;
+    TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    copy_name(b->name, name);
+    sph_node *sel;
+    TRY(sph_node_get_map(n, "select", 1, &sel, err));
+    TRY(parse_selection(s, &b->select, sel, err));
+    int which;
+    TRY(one_of(n, conds, "condition", &which, err));
+    static const sph_condition_kind kinds[] = {SPH_BC_CLAMP, SPH_BC_ROLLER,
+                                               SPH_BC_VELOCITY, SPH_BC_SYMMETRY,
+                                               SPH_BC_SKEW_SYMMETRY};
+    b->kind = kinds[which];
+    b->mask = 7u;
+    b->until = INFINITY;
+    if (b->kind == SPH_BC_CLAMP) {
+      int on;
+      TRY(sph_node_get_bool(n, "clamp", 1, 1, &on, err));
+      if (!on)
+        return sph_node_error(sph_node_child(n, "clamp"), err, SPH_ERR_RANGE,
+                              "clamp: false imposes nothing; remove the "
+                              "boundary instead");
+    } else if (b->kind == SPH_BC_VELOCITY) {
+      sph_node *v;
+      TRY(sph_node_get_map(n, "velocity", 1, &v, err));
+      static const char *const vkeys[] = {"value", "from", "until",
+                                          "components", NULL};
+      TRY(sph_node_check_keys(v, vkeys, err));
+      TRY(sph_node_get_doubles(v, "value", 1, 3, b->value, NULL, err));
+      TRY(sph_node_get_double(v, "from", 0, 0.0, &b->from, err));
+      if (sph_node_child(v, "until")) {
+        TRY(sph_node_get_double(v, "until", 1, 0, &b->until, err));
+        if (!(b->until > b->from))
+          return sph_node_error(sph_node_child(v, "until"), err, SPH_ERR_RANGE,
+                                "until (%g) must be after from (%g)", b->until,
+                                b->from);
+      }
+      sph_node *comp;
+      TRY(get_seq(v, "components", 0, &comp, err));
+      if (comp) {
+        b->mask = 0;
+        for (size_t k = 0; k < comp->count; ++k) {
+          const char *c = comp->items[k]->value;
+          int a = c && strlen(c) == 1 ? c[0] - 'x' : -1;
+          if (a < 0 || a > 2)
+            return sph_node_error(comp->items[k], err, SPH_ERR_RANGE,
+                                  "components are x, y or z");
+          b->mask |= 1u << a;
+        }
+      }
+    } else {
+      sph_node *c;
+      TRY(sph_node_get_map(n, conds[which], 1, &c, err));
+      static const char *const akeys[] = {"axis", NULL};
+      TRY(sph_node_check_keys(c, akeys, err));
+      TRY(get_axis(c, "axis", 1, 0, &b->axis, err));
+      if (b->kind != SPH_BC_ROLLER) {
+        if (b->select.kind != SPH_SELECT_PLANE || b->select.axis != b->axis)
+          return sph_node_error(sph_node_child(n, conds[which]), err,
+                                SPH_ERR_ARG,
+                                "a %s plane needs a plane selection normal "
+                                "to the same axis",
+                                conds[which]);
+      }
+    }
+  }
+  return SPH_OK;
+}
+
+static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
+                             int *nfields, int max, int allow_ids,
+                             sph_error *err) {
+  *nfields = 0;
+  for (size_t i = 0; i < list->count; ++i) {
+    sph_node *it = list->items[i];
+    if (it->kind != SPH_NODE_SCALAR)
+      return sph_node_error(it, err, SPH_ERR_TYPE, "expected a field name");
+    if (allow_ids && !strcmp(it->value, "body_id")) {
+      s->output.body_id = 1;
+      continue;
+    }
+    if (allow_ids && !strcmp(it->value, "particle_id")) {
+      s->output.particle_id = 1;
+      continue;
+    }
+    int f = sph_field_from_name(it->value);
+    if (f < 0) {
+      const char *names[SPH_FIELD_COUNT + 3];
+      int k = 0;
+      for (int j = 0; j < SPH_FIELD_COUNT; ++j)
+        names[k++] = sph_field_name((sph_field)j);
+      if (allow_ids) {
+        names[k++] = "body_id";
+        names[k++] = "particle_id";
+      }
+      names[k] = NULL;
+      const char *hint = sph_suggest(it->value, names);
+      return sph_node_error(it, err, SPH_ERR_RANGE, "unknown field '%s'%s%s%s",
+                            it->value, hint ? "; did you mean '" : "",
+                            hint ? hint : "", hint ? "'?" : "");
+    }
+    if (*nfields >= max)
+      return sph_node_error(it, err, SPH_ERR_RANGE, "at most %d fields", max);
+    fields[(*nfields)++] = f;
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
+  sph_node *png;
+  TRY(sph_node_get_map(out, "png", 0, &png, err));
+  sph_png_output *p = &s->output.png;
+  if (!png)
+    return SPH_OK;
+  static const char *const keys[] = {"width", "height", "color",
+                                     "range", "camera", NULL};
+  TRY(sph_node_check_keys(png, keys, err));
+  p->enabled = 1;
+  long w, h;
+  TRY(sph_node_get_int(png, "width", 0, 1280, &w, err));
+  TRY(sph_node_get_int(png, "height", 0, 720, &h, err));
+  if (w < 16 || w > 16384)
+    return sph_node_error(sph_node_child(png, "width"), err, SPH_ERR_RANGE,
+                          "width must be in [16, 16384], got %ld", w);
+  if (h < 16 || h > 16384)
+    return sph_node_error(sph_node_child(png, "height"), err, SPH_ERR_RANGE,
+                          "height must be in [16, 16384], got %ld", h);
+  p->width = (int)w;
+  p->height = (int)h;
+  const char *color;
+  TRY(sph_node_get_string(png, "color", 0, "pressure", &color, err));
+  int f = sph_field_from_name(color);
+  if (f < 0)
+    return sph_node_error(sph_node_child(png, "color"), err, SPH_ERR_RANGE,
+                          "unknown field '%s'", color);
+  p->color_field = f;
+  sph_node *range = sph_node_child(png, "range");
+  snprintf(p->range_mode, sizeof p->range_mode, "symmetric");
+  if (range && range->kind == SPH_NODE_SEQ) {
+    range->used = 1;
+    TRY(sph_node_get_doubles(png, "range", 1, 2, p->range, NULL, err));
+    if (!(p->range[1] > p->range[0]))
+      return sph_node_error(range, err, SPH_ERR_RANGE,
+                            "range [min, max] needs min < max");
+    snprintf(p->range_mode, sizeof p->range_mode, "fixed");
+  } else {
+    const char *mode;
+    TRY(sph_node_get_string(png, "range", 0, "symmetric", &mode, err));
+    if (strcmp(mode, "auto") && strcmp(mode, "symmetric") &&
+        strcmp(mode, "global"))
+      return sph_node_error(sph_node_child(png, "range"), err, SPH_ERR_RANGE,
+                            "range is auto, symmetric, global or [min, max], "
+                            "got '%s'",
+                            mode);
+    snprintf(p->range_mode, sizeof p->range_mode, "%s", mode);
+  }
+  sph_node *cam;
+  TRY(sph_node_get_map(png, "camera", 0, &cam, err));
+  if (cam) {
+    static const char *const ckeys[] = {"position",   "target",    "up",
+                                        "azimuth",    "elevation", "zoom",
+                                        "projection", NULL};
+    TRY(sph_node_check_keys(cam, ckeys, err));
+    sph_camera *c = &p->camera;
+    c->given = 1;
+    c->up[1] = 1.0;
+    c->zoom = 1.0;
+    if (sph_node_child(cam, "position")) {
+      c->has_position = 1;
+      TRY(sph_node_get_doubles(cam, "position", 1, 3, c->position, NULL, err));
+    }
+    if (sph_node_child(cam, "target"))
+      TRY(sph_node_get_doubles(cam, "target", 1, 3, c->target, NULL, err));
+    if (sph_node_child(cam, "up"))
+      TRY(sph_node_get_doubles(cam, "up", 1, 3, c->up, NULL, err));
+    TRY(sph_node_get_double(cam, "azimuth", 0, 0.0, &c->azimuth, err));
+    TRY(sph_node_get_double(cam, "elevation", 0, 0.0, &c->elevation, err));
+    TRY(positive(cam, "zoom", 0, 1.0, &c->zoom, err));
+    const char *proj;
+    TRY(sph_node_get_string(cam, "projection", 0, "orthographic", &proj, err));
+    if (strcmp(proj, "orthographic") && strcmp(proj, "perspective"))
+      return sph_node_error(sph_node_child(cam, "projection"), err,
+                            SPH_ERR_RANGE,
+                            "projection is orthographic or perspective");
+    c->orthographic = !strcmp(proj, "orthographic");
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
+  sph_node *out;
+  TRY(sph_node_insert_default(root, "output", "{}", &out, err));
+  if (out->kind != SPH_NODE_MAP)
+    return sph_node_error(out, err, SPH_ERR_TYPE, "expected a mapping");
+  static const char *const keys[] = {"every",  "fields",           "vtk", "png",
+                                     "probes", "checkpoint_every", NULL};
+  TRY(sph_node_check_keys(out, keys, err));
+  sph_output *o = &s->output;
+  TRY(positive(out, "every", 0, s->t_end / 100.0, &o->every, err));
+  if (o->every > s->t_end * (1 + 1e-12))
+    return sph_node_error(sph_node_child(out, "every"), err, SPH_ERR_RANGE,
+                          "output interval %g is longer than the run (%g)",
+                          o->every, s->t_end);
+  sph_node *fields;
+  TRY(sph_node_insert_default(
+      out, "fields",
+      "[pressure, velocity, displacement, von_mises, J, body_id]", &fields,
+      err));
+  if (fields->kind != SPH_NODE_SEQ)
+    return sph_node_error(fields, err, SPH_ERR_TYPE,
+                          "expected a list of field names");
+  TRY(field_list(s, fields, o->fields, &o->nfields, SPH_FIELD_COUNT, 1, err));
+  sph_node *vtk = sph_node_child(out, "vtk");
+  o->vtk = 1;
+  if (vtk && vtk->kind == SPH_NODE_MAP) {
+    vtk->used = 1;
+    static const char *const vkeys[] = {"format", NULL};
+    TRY(sph_node_check_keys(vtk, vkeys, err));
+    const char *fmt;
+    TRY(sph_node_get_string(vtk, "format", 0, "binary", &fmt, err));
+    if (strcmp(fmt, "binary") && strcmp(fmt, "ascii"))
+      return sph_node_error(sph_node_child(vtk, "format"), err, SPH_ERR_RANGE,
+                            "format is binary or ascii, got '%s'", fmt);
+    o->vtk_ascii = !strcmp(fmt, "ascii");
+  } else {
+    TRY(sph_node_get_bool(out, "vtk", 0, 1, &o->vtk, err));
+  }
+  TRY(parse_png(s, out, err));
+  if (sph_node_child(out, "checkpoint_every"))
+    TRY(positive(out, "checkpoint_every", 1, 0, &o->checkpoint_every, err));
+  sph_node *probes;
+  TRY(get_seq(out, "probes", 0, &probes, err));
+  if (probes && probes->count) {
+    o->probes = calloc(probes->count, sizeof *o->probes);
+    if (!o->probes)
+      return sph_error_set(err, SPH_ERR_NOMEM, "probes");
+    static const char *const pkeys[] = {"name", "at", "fields", NULL};
+    for (size_t i = 0; i < probes->count; ++i) {
+      sph_node *n = probes->items[i];
+      sph_probe *p = &o->probes[i];
+      o->nprobes++;
+      if (n->kind != SPH_NODE_MAP)
+        return sph_node_error(n, err, SPH_ERR_TYPE,
+                              "expected a probe (a mapping)");
+      TRY(sph_node_check_keys(n, pkeys, err));
+      const char *name;
+      TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+      copy_name(p->name, name);
+      TRY(sph_node_get_doubles(n, "at", 1, (size_t)s->dimension, p->at, NULL,
+                               err));
+      sph_node *at = sph_node_child(n, "at");
+      p->line = at->line;
+      p->col = at->col;
+      sph_node *pf;
+      TRY(sph_node_insert_default(n, "fields", "[displacement, velocity]", &pf,
+                                  err));
+      if (pf->kind != SPH_NODE_SEQ)
+        return sph_node_error(pf, err, SPH_ERR_TYPE,
+                              "expected a list of field names");
+      TRY(field_list(s, pf, p->fields, &p->nfields, 8, 0, err));
+    }
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
+  if (root->kind != SPH_NODE_MAP)
+    return sph_node_error(root, err, SPH_ERR_TYPE,
+                          "a scene is a mapping of keys (name, dimension, "
+                          "method, materials, bodies, time, ...)");
+  static const char *const keys[] = {
+      "name",       "dimension",  "method", "kernel", "materials", "bodies",
+      "boundaries", "body_force", "time",   "output", "reference", NULL};
+  TRY(sph_node_check_keys(root, keys, err));
+  const char *name;
+  TRY(sph_node_get_string(root, "name", 1, NULL, &name, err));
+  size_t len = strlen(name);
+  int ok = len > 0 && len < SPH_NAME_MAX;
+  for (const char *c = name; *c && ok; ++c)
+    ok = isalnum((unsigned char)*c) || *c == '_' || *c == '-';
+  if (!ok)
+    return sph_node_error(sph_node_child(root, "name"), err, SPH_ERR_RANGE,
+                          "a scene name is 1-63 letters, digits, '_' or '-' "
+                          "(it names the output folder), got '%s'",
+                          name);
+  copy_name(s->name, name);
+  long dim;
+  TRY(sph_node_get_int(root, "dimension", 1, 3, &dim, err));
+  if (dim != 2 && dim != 3)
+    return sph_node_error(sph_node_child(root, "dimension"), err, SPH_ERR_RANGE,
+                          "dimension is 2 or 3, got %ld", dim);
+  s->dimension = (int)dim;
+  TRY(sph_node_get_map(root, "method", 1, &s->method, err));
+  const char *method;
+  TRY(sph_node_get_string(s->method, "name", 1, NULL, &method, err));
+  copy_name(s->method_name, method);
+  TRY(sph_node_get_map(root, "reference", 0, &s->reference, err));
+  sph_node *time;
+  TRY(sph_node_get_map(root, "time", 1, &time, err));
+  static const char *const tkeys[] = {"end", NULL};
+  TRY(sph_node_check_keys(time, tkeys, err));
+  TRY(positive(time, "end", 1, 0, &s->t_end, err));
+  TRY(parse_kernel(s, root, err));
+  TRY(parse_materials(s, root, err));
+  TRY(parse_bodies(s, root, err));
+  TRY(parse_boundaries(s, root, err));
+  if (sph_node_child(root, "body_force")) {
+    s->has_body_force = 1;
+    TRY(sph_node_get_doubles(root, "body_force", 1, 3, s->body_force, NULL,
+                             err));
+  }
+  TRY(parse_output(s, root, err));
+  return SPH_OK;
+}
+
+sph_status sph_scene_load(sph_scene **out, const char *path,
+                          const char *const *overrides, size_t nset,
+                          sph_error *err) {
+  *out = NULL;
+  sph_scene *s = calloc(1, sizeof *s);
+  if (!s)
+    return sph_error_set(err, SPH_ERR_NOMEM, "scene");
+  snprintf(s->path, sizeof s->path, "%s", path);
+  sph_status st = sph_node_load_file(&s->root, path, err);
+  for (size_t i = 0; st == SPH_OK && i < nset; ++i)
+    st = sph_node_set(s->root, overrides[i], err);
+  if (st == SPH_OK)
+    st = parse_scene(s, s->root, err);
+  if (st != SPH_OK) {
+    sph_scene_destroy(s);
+    return st;
+  }
+  *out = s;
+  return SPH_OK;
+}
+
+void sph_scene_destroy(sph_scene *s) {
+  if (!s)
+    return;
+  for (size_t i = 0; i < s->nbodies; ++i) {
+    sph_expr_destroy(s->bodies[i].velocity.profile);
+    for (int c = 0; c < 3; ++c)
+      sph_expr_destroy(s->bodies[i].velocity.expr[c]);
+  }
+  free(s->bodies);
+  free(s->materials);
+  free(s->boundaries);
+  free(s->output.probes);
+  sph_node_destroy(s->root);
+  free(s);
+}
+
+double sph_scene_min_spacing(const sph_scene *s) {
+  double dp = INFINITY;
+  for (size_t b = 0; b < s->nbodies; ++b)
+    dp = s->bodies[b].spacing < dp ? s->bodies[b].spacing : dp;
+  return dp;
+}
+
+int sph_scene_find_material(const sph_scene *s, const char *name) {
+  for (size_t i = 0; i < s->nmaterials; ++i)
+    if (!strcmp(s->materials[i].name, name))
+      return (int)i;
+  return -1;
+}
+
+int sph_scene_find_body(const sph_scene *s, const char *name) {
+  for (size_t i = 0; i < s->nbodies; ++i)
+    if (!strcmp(s->bodies[i].name, name))
+      return (int)i;
+  return -1;
+}
+
+int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
+                           int body, const double X[3]) {
+  if (sel->body >= 0 && body != sel->body)
+    return 0;
+  switch (sel->kind) {
+  case SPH_SELECT_PLANE:
+    return fabs(X[sel->axis] - sel->at) <= sel->tolerance;
+  case SPH_SELECT_BOX:
+    for (int c = 0; c < s->dimension; ++c)
+      if (X[c] < sel->min[c] - sel->tolerance ||
+          X[c] > sel->max[c] + sel->tolerance)
+        return 0;
+    return 1;
+  case SPH_SELECT_FACE: {
+    double lo[3], hi[3];
+    const sph_body *b = &s->bodies[sel->body];
+    sph_shape_bounds(&b->shape, s->dimension, lo, hi);
+    double at = sel->side > 0 ? hi[sel->axis] : lo[sel->axis];
+    return fabs(X[sel->axis] - at) <= 0.5 * b->spacing;
+  }
+  }
+  return 0;
+}
+
+/* ---- particles
+ * ----------------------------------------------------------------- */
+
+static void initial_velocity(const sph_velocity *v, const double X[3],
+                             double out[3]) {
+  out[0] = out[1] = out[2] = 0.0;
+  switch (v->kind) {
+  case SPH_VEL_NONE:
+    return;
+  case SPH_VEL_UNIFORM:
+    memcpy(out, v->value, 3 * sizeof *out);
+    return;
+  case SPH_VEL_ROTATION: {
+    double w =
+        v->omega *
+        (v->profile ? sph_expr_eval(v->profile, X[0], X[1], X[2], 0.0) : 1.0);
+    double omega[3] = {0, 0, 0}, r[3];
+    omega[v->axis] = w;
+    for (int c = 0; c < 3; ++c)
+      r[c] = X[c] - v->center[c];
+    out[0] = omega[1] * r[2] - omega[2] * r[1];
+    out[1] = omega[2] * r[0] - omega[0] * r[2];
+    out[2] = omega[0] * r[1] - omega[1] * r[0];
+    return;
+  }
+  case SPH_VEL_EXPRESSION:
+    for (int c = 0; c < 3; ++c)
+      out[c] = sph_expr_eval(v->expr[c], X[0], X[1], X[2], 0.0);
+    return;
+  }
+}
+
+static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
+                                sph_error *err) {
+  if (s->nbodies < 2)
+    return SPH_OK;
+  sph_neighbors *nl;
+  TRY(sph_neighbors_create(&nl, err));
+  sph_status st = sph_neighbors_build(
+      nl, ps->field[SPH_FIELD_POSITION0], ps->n, s->dimension,
+      0.5 * sph_scene_min_spacing(s), NULL, SPH_PAIRS_ALL, err);
+  for (size_t a = 0; st == SPH_OK && a < ps->n; ++a)
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      if (ps->body[b] == ps->body[a])
+        continue;
+      const sph_body *A = &s->bodies[ps->body[a]], *B = &s->bodies[ps->body[b]];
+      const sph_body *later = ps->body[a] > ps->body[b] ? A : B;
+      const sph_body *first = later == A ? B : A;
+      char key[32];
+      snprintf(key, sizeof key, "bodies[%d]", (int)(later - s->bodies));
+      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, later->line, later->col,
+                        key,
+                        "body '%s' overlaps body '%s' (particles %.3g m "
+                        "apart)",
+                        later->name, first->name,
+                        sqrt(pow(ps->field[SPH_FIELD_POSITION0][3 * a] -
+                                     ps->field[SPH_FIELD_POSITION0][3 * b],
+                                 2) +
+                             pow(ps->field[SPH_FIELD_POSITION0][3 * a + 1] -
+                                     ps->field[SPH_FIELD_POSITION0][3 * b + 1],
+                                 2) +
+                             pow(ps->field[SPH_FIELD_POSITION0][3 * a + 2] -
+                                     ps->field[SPH_FIELD_POSITION0][3 * b + 2],
+                                 2)));
+      break;
+    }
+  sph_neighbors_destroy(nl);
+  return st;
+}
+
+sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
+                                     sph_error *err) {
+  *out = NULL;
+  double **xs = calloc(s->nbodies, sizeof *xs);
+  double **vs = calloc(s->nbodies, sizeof *vs);
+  size_t *ns = calloc(s->nbodies, sizeof *ns), total = 0;
+  sph_status st =
+      xs && vs && ns ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "bodies");
+  for (size_t b = 0; st == SPH_OK && b < s->nbodies; ++b) {
+    st = sph_body_generate(&s->bodies[b], s->dimension, &xs[b], &vs[b], &ns[b],
+                           err);
+    if (st != SPH_OK) {
+      char msg[768], key[32];
+      snprintf(msg, sizeof msg, "%s", err->message);
+      snprintf(key, sizeof key, "bodies[%zu]", b);
+      st = sph_error_at(err, st, s->path, s->bodies[b].line, s->bodies[b].col,
+                        key, "%s", msg);
+    }
+    total += ns[b];
+  }
+  sph_particles *ps = NULL;
+  if (st == SPH_OK)
+    st = sph_particles_create(&ps, total, s->dimension, err);
+  if (st == SPH_OK)
+    st = sph_particles_require(ps, SPH_FIELD_VELOCITY, err);
+  for (size_t b = 0; st == SPH_OK && b < s->nbodies; ++b)
+    for (size_t i = 0; st == SPH_OK && i < ns[b]; ++i) {
+      st = sph_particles_append(ps, xs[b] + 3 * i, vs[b][i], (int32_t)b, err);
+      initial_velocity(&s->bodies[b].velocity, xs[b] + 3 * i,
+                       ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1));
+    }
+  for (size_t b = 0; xs && vs && b < s->nbodies; ++b) {
+    free(xs[b]);
+    free(vs[b]);
+  }
+  free(xs);
+  free(vs);
+  free(ns);
+  if (st == SPH_OK)
+    st = check_overlap(s, ps, err);
+  /* boundary selections */
+  for (size_t k = 0; st == SPH_OK && k < s->nboundaries; ++k) {
+    const sph_boundary *bc = &s->boundaries[k];
+    size_t hits = 0;
+    for (size_t i = 0; i < ps->n; ++i)
+      if (sph_selection_contains(s, &bc->select, ps->body[i],
+                                 ps->field[SPH_FIELD_POSITION0] + 3 * i)) {
+        ps->flags[i] |= SPH_FLAG_BOUNDARY;
+        ++hits;
+      }
+    if (!hits) {
+      char key[48];
+      snprintf(key, sizeof key, "boundaries[%zu].select", k);
+      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, bc->line, bc->col, key,
+                        "boundary '%s' selects no particle", bc->name);
+    }
+  }
+  /* probes: within one spacing of a particle */
+  for (size_t k = 0; st == SPH_OK && k < s->output.nprobes; ++k) {
+    const sph_probe *p = &s->output.probes[k];
+    int inside = 0;
+    for (size_t i = 0; i < ps->n && !inside; ++i) {
+      const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * i;
+      double d2 = 0.0;
+      for (int c = 0; c < s->dimension; ++c)
+        d2 += (X[c] - p->at[c]) * (X[c] - p->at[c]);
+      double h = s->bodies[ps->body[i]].spacing;
+      inside = d2 <= h * h;
+    }
+    if (!inside) {
+      char key[48];
+      snprintf(key, sizeof key, "output.probes[%zu].at", k);
+      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, p->line, p->col, key,
+                        "probe '%s' at (%g, %g, %g) is outside every body",
+                        p->name, p->at[0], p->at[1],
+                        s->dimension == 3 ? p->at[2] : 0.0);
+    }
+  }
+  if (st != SPH_OK) {
+    sph_particles_destroy(ps);
+    return st;
+  }
+  *out = ps;
+  return SPH_OK;
+}
