@@ -17,7 +17,7 @@ static void first_comment(const char *path, char *buf, size_t size) {
   FILE *f = fopen(path, "r");
   if (!f)
     return;
-  char line[512];
+  char line[1024];
   while (fgets(line, sizeof line, f)) {
     if (line[0] != '#')
       continue;
@@ -25,7 +25,7 @@ static void first_comment(const char *path, char *buf, size_t size) {
     while (*s == ' ')
       ++s;
     s[strcspn(s, "\r\n")] = '\0';
-    snprintf(buf, size, "%s", s);
+    snprintf(buf, size, "%.*s", (int)size - 1, s);
     break;
   }
   fclose(f);

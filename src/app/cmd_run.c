@@ -1,1 +1,246 @@
-/* placeholder: being written */
+/* sph run: load and validate a scene, then simulate it to time.end,
+ * writing every output through the sinks (DESIGN.md sec. 1-2). Nothing is
+ * written until the scene, its particles and its method have all been
+ * validated. */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "app/app_impl.h"
+#include "app/progress_impl.h"
+#include "sph/scene.h"
+#include "sph/sim.h"
+#include "sph/sink.h"
+#include "sph/stability.h"
+
+static int mkdir_p(const char *path) {
+  char buf[1024];
+  snprintf(buf, sizeof buf, "%s", path);
+  for (char *p = buf + 1; *p; ++p)
+    if (*p == '/') {
+      *p = '\0';
+      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+        return -1;
+      *p = '/';
+    }
+  return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
+}
+
+static int file_exists(const char *dir, const char *name) {
+  char path[1200];
+  struct stat st;
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  return stat(path, &st) == 0;
+}
+
+/* Removes only the files an earlier run of ours wrote. */
+static void remove_previous(const char *dir) {
+  static const char *const names[] = {"summary.json", "energy.csv",
+                                      "probes.csv", "scene_used.yaml", NULL};
+  char path[1200];
+  for (const char *const *n = names; *n; ++n) {
+    snprintf(path, sizeof path, "%s/%s", dir, *n);
+    remove(path);
+  }
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  while (d && (e = readdir(d))) {
+    size_t len = strlen(e->d_name);
+    if ((len > 4 && !strcmp(e->d_name + len - 4, ".vtp")) ||
+        (len > 4 && !strcmp(e->d_name + len - 4, ".pvd"))) {
+      snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+      remove(path);
+    }
+  }
+  if (d)
+    closedir(d);
+}
+
+static void banner(const sph_sim *sim, const char *dir) {
+  const sph_scene *s = sim->scene;
+  printf("sph: %s (%s)\n", s->name, s->path);
+  printf("  method     %s: %s\n             [%s]\n", sim->method->name,
+         sim->method->title, sim->method->reference);
+  printf("  particles  %zu in %zu bod%s, dp = %.4g m, kernel %s h = %.4g m\n",
+         sim->ps->n, s->nbodies, s->nbodies == 1 ? "y" : "ies", sim->dp,
+         sph_kernel_type_name(s->kernel_type), sim->kernel.h);
+  printf("  terms     ");
+  if (!sim->nterms)
+    printf(" (none)");
+  for (int i = 0; i < sim->nterms; ++i)
+    printf(" %s", sim->terms[i].ops->name);
+  printf("\n  time       0 .. %.6g s, output every %.6g s, %d thread%s\n",
+         s->t_end, s->output.every, sim->threads, sim->threads == 1 ? "" : "s");
+  printf("  output     %s/\n", dir);
+  fflush(stdout);
+}
+
+static sph_status write_scene_used(const sph_scene *s, const char *dir,
+                                   sph_error *err) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/scene_used.yaml", dir);
+  sph_atomic_file af;
+  sph_status st = sph_atomic_open(&af, path, err);
+  if (st != SPH_OK)
+    return st;
+  fprintf(af.f, "# %s as run by sph, every default filled in\n", s->path);
+  st = sph_node_write(s->root, af.f, err);
+  if (st == SPH_OK)
+    st = sph_atomic_commit(&af, err);
+  if (st != SPH_OK)
+    sph_atomic_abort(&af);
+  return st;
+}
+
+/* derive, then every sink and the verdict see the same frame */
+static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
+                               sph_verdict *v, int index, sph_error *err) {
+  sph_status st = sim->method->derive(sim, err);
+  if (st != SPH_OK)
+    return st;
+  sph_frame fr = {.time = sim->t,
+                  .step = sim->steps,
+                  .index = index,
+                  .sim = sim,
+                  .ps = sim->ps};
+  sim->method->energy(sim, &fr.kinetic, &fr.strain);
+  for (int i = 0; i < nsinks && st == SPH_OK; ++i)
+    st = sinks[i].ops->write(&sinks[i], &fr, err);
+  sph_verdict_observe(v, &fr);
+  return st;
+}
+
+int sph_cmd_run(int argc, char **argv) {
+  sph_app_args args;
+  int rc = sph_app_parse_args(argc, argv, 2, &args, "run");
+  if (rc != SPH_EXIT_OK)
+    return rc;
+  const char *path = args.scene ? args.scene : sph_app_default_scene();
+  sph_error err;
+  sph_error_clear(&err);
+  sph_scene *scene = NULL;
+  sph_sim *sim = NULL;
+  sph_status st = sph_scene_load(&scene, path, args.sets, args.nsets, &err);
+  if (st == SPH_OK)
+    st = sph_sim_create(&sim, scene, &err);
+  if (st != SPH_OK) {
+    sph_app_print_error(&err);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
+  char dir[1024];
+  if (args.out)
+    snprintf(dir, sizeof dir, "%s", args.out);
+  else
+    snprintf(dir, sizeof dir, "outputs/%s", scene->name);
+  if ((file_exists(dir, "summary.json") ||
+       file_exists(dir, "scene_used.yaml")) &&
+      !args.overwrite) {
+    fprintf(stderr,
+            "sph: %s holds the results of an earlier run; pass --overwrite "
+            "to replace them or --out DIR to write elsewhere\n",
+            dir);
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
+  if (mkdir_p(dir) != 0) {
+    fprintf(stderr, "sph: cannot create the output folder %s: %s\n", dir,
+            strerror(errno));
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
+  if (args.overwrite)
+    remove_previous(dir);
+  if (!args.quiet)
+    banner(sim, dir);
+
+  sph_sink sinks[2];
+  int nsinks = 0;
+  sinks[nsinks++] = (sph_sink){.ops = &sph_energy_sink_ops};
+  if (scene->output.nprobes)
+    sinks[nsinks++] = (sph_sink){.ops = &sph_probe_sink_ops};
+  sph_verdict *verdict = NULL;
+  st = write_scene_used(scene, dir, &err);
+  if (st == SPH_OK)
+    st = sph_verdict_create(&verdict, sim, &err);
+  for (int i = 0; i < nsinks && st == SPH_OK; ++i)
+    st = sinks[i].ops->open(&sinks[i], sim, dir, &err);
+
+  sph_progress prog;
+  sph_progress_start(&prog, scene->t_end, args.quiet);
+  double wall0 = sph_wtime();
+  int completed = 0, index = 0;
+  if (st == SPH_OK)
+    st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
+  double t_end = scene->t_end, every = scene->output.every;
+  double eps = 1e-12 * t_end;
+  while (st == SPH_OK && verdict->stable && sim->t < t_end - eps) {
+    double next = fmin(t_end, every * (double)index);
+    st = sph_sim_step(sim, next - sim->t, &err);
+    if (st != SPH_OK)
+      break;
+    sph_progress_step(&prog, sim->t, sim->steps);
+    if (sim->t >= next - eps) {
+      sim->t = next; /* land exactly on the output time */
+      st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
+      sph_progress_output(&prog, sim->t, sim->steps);
+    }
+  }
+  sph_progress_finish(&prog);
+  double wall = sph_wtime() - wall0;
+  int failed_step = st != SPH_OK && st != SPH_ERR_IO;
+  if (st == SPH_OK && verdict->stable)
+    completed = 1;
+  if (failed_step && verdict) {
+    char msg[1024];
+    sph_error_format(&err, msg, sizeof msg);
+    sph_verdict_fail(verdict, sim->t, msg);
+    if (err.code == SPH_ERR_NUMERIC)
+      verdict->nan = 1;
+  }
+  /* close the sinks (files renamed into place) and write the summary */
+  sph_error cerr;
+  int io_failed = st == SPH_ERR_IO;
+  for (int i = 0; i < nsinks; ++i) {
+    if (sinks[i].data && !io_failed &&
+        sinks[i].ops->close(&sinks[i], &cerr) != SPH_OK) {
+      io_failed = 1;
+      err = cerr;
+    }
+    if (sinks[i].ops->destroy)
+      sinks[i].ops->destroy(&sinks[i]);
+  }
+  if (verdict && !io_failed) {
+    char spath[1200];
+    snprintf(spath, sizeof spath, "%s/summary.json", dir);
+    if (sph_summary_write(spath, sim, verdict, wall, completed, &cerr) !=
+        SPH_OK) {
+      io_failed = 1;
+      err = cerr;
+    }
+  }
+  if (io_failed) {
+    sph_app_print_error(&err);
+    rc = SPH_EXIT_FAIL;
+  } else if (verdict && !verdict->stable) {
+    printf("verdict: UNSTABLE - %s at t = %.6g s (%lu steps, %.2f s wall)\n",
+           verdict->reason, verdict->t_tripped, sim->steps, wall);
+    rc = SPH_EXIT_FAIL;
+  } else {
+    printf("verdict: stable (%lu steps, %.2f s wall, %.3g particle-steps/s)\n",
+           sim->steps, wall,
+           wall > 0 ? (double)sim->steps * (double)sim->ps->n / wall : 0.0);
+    rc = SPH_EXIT_OK;
+  }
+  sph_verdict_destroy(verdict);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(scene);
+  return rc;
+}

@@ -1,1 +1,100 @@
-/* placeholder: being written */
+/* summary.json: what ran, how long each part took, conservation and the
+ * stability verdict (keys listed in the README). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sph/stability.h"
+
+static void json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s) {
+    unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\')
+      fprintf(f, "\\%c", c);
+    else if (c < 0x20)
+      fprintf(f, "\\u%04x", c);
+    else
+      fputc(c, f);
+  }
+  fputc('"', f);
+}
+
+static void json_number(FILE *f, double x) {
+  if (isfinite(x))
+    fprintf(f, "%.17g", x);
+  else
+    fputs("null", f);
+}
+
+sph_status sph_summary_write(const char *path, const sph_sim *sim,
+                             const sph_verdict *v, double wall_seconds,
+                             int completed, sph_error *err) {
+  sph_atomic_file af;
+  sph_status st = sph_atomic_open(&af, path, err);
+  if (st != SPH_OK)
+    return st;
+  FILE *f = af.f;
+  fputs("{\n  \"scene\": ", f);
+  json_string(f, sim->scene->name);
+  fputs(",\n  \"method\": {\"name\": ", f);
+  json_string(f, sim->method->name);
+  fputs(", \"title\": ", f);
+  json_string(f, sim->method->title);
+  fputs(", \"reference\": ", f);
+  json_string(f, sim->method->reference);
+  fputs("},\n  \"terms\": {", f);
+  int first = 1;
+  for (int i = 0; i < sim->ntimers; ++i) {
+    fputs(first ? "" : ", ", f);
+    first = 0;
+    json_string(f, sim->timers[i].name);
+    fputs(": ", f);
+    json_number(f, sim->timers[i].seconds);
+  }
+  for (int i = 0; i < sim->nterms; ++i) {
+    fputs(first ? "" : ", ", f);
+    first = 0;
+    json_string(f, sim->terms[i].ops->name);
+    fputs(": ", f);
+    json_number(f, sim->terms[i].seconds);
+  }
+  fprintf(f, "},\n  \"particles\": %zu,\n  \"steps\": %lu,\n", sim->ps->n,
+          sim->steps);
+  fputs("  \"wall_seconds\": ", f);
+  json_number(f, wall_seconds);
+  fputs(",\n  \"dt_min\": ", f);
+  json_number(f, sim->steps ? sim->dt_min : NAN);
+  fputs(",\n  \"dt_max\": ", f);
+  json_number(f, sim->steps ? sim->dt_max : NAN);
+  fputs(",\n  \"energy\": {\"initial\": ", f);
+  json_number(f, v->energy0);
+  fputs(", \"final\": ", f);
+  json_number(f, v->energy_final);
+  fputs(", \"max\": ", f);
+  json_number(f, v->energy_max);
+  fputs("},\n  \"linear_momentum_drift\": ", f);
+  json_number(f, v->lin_drift);
+  fputs(",\n  \"angular_momentum_drift\": ", f);
+  json_number(f, v->ang_drift);
+  fputs(",\n  \"J\": {\"min\": ", f);
+  json_number(f, v->J_min);
+  fputs(", \"max\": ", f);
+  json_number(f, v->J_max);
+  fputs("},\n  \"checkerboard_max\": ", f);
+  json_number(f, v->checkerboard_max);
+  fprintf(f, ",\n  \"nan\": %s,\n  \"stable\": %s,\n  \"reason\": ",
+          v->nan ? "true" : "false", v->stable ? "true" : "false");
+  json_string(f, v->reason);
+  fputs(",\n  \"tripped_at\": ", f);
+  json_number(f, v->stable ? NAN : v->t_tripped);
+  fprintf(f, ",\n  \"threads\": %d,\n  \"t_end\": ", sim->threads);
+  json_number(f, sim->scene->t_end);
+  fputs(",\n  \"t_reached\": ", f);
+  json_number(f, sim->t);
+  fprintf(f, ",\n  \"completed\": %s\n}\n", completed ? "true" : "false");
+  st = sph_atomic_commit(&af, err);
+  if (st != SPH_OK)
+    sph_atomic_abort(&af);
+  return st;
+}

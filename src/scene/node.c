@@ -611,6 +611,40 @@ sph_status sph_node_get_map(sph_node *map, const char *key, int required,
   return SPH_OK;
 }
 
+sph_status sph_node_insert_default(sph_node *map, const char *key,
+                                   const char *yaml, sph_node **out,
+                                   sph_error *err) {
+  *out = sph_node_child(map, key);
+  if (*out) {
+    (*out)->used = 1;
+    return SPH_OK;
+  }
+  if (map->kind != SPH_NODE_MAP)
+    return sph_node_error(map, err, SPH_ERR_TYPE, "expected a mapping, got %s",
+                          kind_name(map->kind));
+  sph_node *n = NULL;
+  sph_status st = sph_node_load_string(&n, yaml, map->file, err);
+  if (st != SPH_OK)
+    return st;
+  node_set_origin(n, map->file, map->line, map->col);
+  n->is_default = 1;
+  n->used = 1;
+  size_t len = strlen(map->path) + strlen(key) + 2;
+  char *p = malloc(len);
+  if (!p || node_append(map, key, n)) {
+    free(p);
+    sph_node_destroy(n);
+    return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
+  }
+  snprintf(p, len, "%s%s%s", map->path, *map->path ? "." : "", key);
+  int rc = node_set_path(n, p);
+  free(p);
+  if (rc)
+    return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
+  *out = n;
+  return SPH_OK;
+}
+
 /* ---- overrides
  * --------------------------------------------------------------- */
 

@@ -1,1 +1,119 @@
-/* placeholder: being written */
+/* Jameson-Schmidt-Turkel dissipation, seed 000 eq. 35-38 (seed 003
+ * eq. 13-15): D(u) = eps2 c_p h L[u] - eps4 c_p h^3 L[L[u]] with the
+ * corrected particle Laplacian L[u]_a = sum_b V_b (u_b - u_a) Lap W~_b(X_a),
+ * for u = p (into dp) or u = J (into dJ), never F or H (involutions). The
+ * conservative projections of eq. 49 (p: zero sum and moment per body) and
+ * eq. 51 (J: zero volume-weighted sum per body) are applied when asked. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "terms/terms_impl.h"
+
+typedef struct jst {
+  jst_params p;
+  double *lu; /* L[u] */
+  double *d;  /* D(u) */
+} jst;
+
+static void laplacian(const jst *j, const double *V, const double *u,
+                      double *out, long n) {
+  const sph_neighbors *nl = j->p.nl;
+  int nc = j->p.ncomp;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double s[3] = {0, 0, 0};
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double w = V[b] * j->p.lap[k];
+      for (int c = 0; c < nc; ++c)
+        s[c] += w * (u[nc * b + c] - u[nc * a + c]);
+    }
+    for (int c = 0; c < nc; ++c)
+      out[nc * a + c] = s[c];
+  }
+}
+
+static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
+                            sph_error *err) {
+  jst *j = term->data;
+  const sph_particles *ps = sim->ps;
+  const double *V = ps->field[SPH_FIELD_VOLUME0];
+  long n = (long)ps->n;
+  int nc = j->p.ncomp;
+  const double *u = nc == 3 ? stage->p : stage->J;
+  double *rate = nc == 3 ? stage->dp : stage->dJ;
+  double c2 = j->p.eps2 * j->p.cp * j->p.h;
+  double c4 = j->p.eps4 * j->p.cp * j->p.h * j->p.h * j->p.h;
+  laplacian(j, V, u, j->lu, n);
+  if (c4 != 0.0)
+    laplacian(j, V, j->lu, j->d, n); /* L[L[u]] */
+  for (long i = 0; i < nc * n; ++i)
+    j->d[i] = c2 * j->lu[i] - (c4 != 0.0 ? c4 * j->d[i] : 0.0);
+  if (j->p.project) {
+    if (nc == 3) {
+      sph_momentum_projection(ps->n, V, stage->x_moment, ps->body,
+                              (int)sim->scene->nbodies, j->d);
+    } else {
+      for (size_t b = 0; b < sim->scene->nbodies; ++b) {
+        double sv = 0.0, sd = 0.0;
+        for (long a = 0; a < n; ++a)
+          if (ps->body[a] == (int32_t)b) {
+            sv += V[a];
+            sd += V[a] * j->d[a];
+          }
+        double mu = sv > 0.0 ? -sd / sv : 0.0;
+        for (long a = 0; a < n; ++a)
+          if (ps->body[a] == (int32_t)b)
+            j->d[a] += mu;
+      }
+    }
+  }
+  for (long i = 0; i < nc * n; ++i)
+    rate[i] += j->d[i];
+  return SPH_OK;
+}
+
+static void jst_destroy(sph_term *term) {
+  jst *j = term->data;
+  if (!j)
+    return;
+  free(j->lu);
+  free(j->d);
+  free(j);
+}
+
+static const sph_term_ops jst_p_ops = {
+    .name = "jst_dissipation_p",
+    .reference = "seed 000 eq. 35-38, projection eq. 49",
+    .rates = jst_rates,
+    .destroy = jst_destroy,
+};
+
+static const sph_term_ops jst_j_ops = {
+    .name = "jst_dissipation_J",
+    .reference = "seed 000 eq. 35-38, projection eq. 51",
+    .rates = jst_rates,
+    .destroy = jst_destroy,
+};
+
+sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
+                                  sph_error *err) {
+  jst *j = calloc(1, sizeof *j);
+  size_t len = (size_t)p->ncomp * (sim->ps->n ? sim->ps->n : 1);
+  if (!j || !(j->lu = calloc(len, sizeof(double))) ||
+      !(j->d = calloc(len, sizeof(double)))) {
+    if (j) {
+      free(j->lu);
+      free(j);
+    }
+    return sph_error_set(err, SPH_ERR_NOMEM, "JST work arrays");
+  }
+  j->p = *p;
+  sph_status st =
+      sph_sim_add_term(sim, p->ncomp == 3 ? &jst_p_ops : &jst_j_ops, j, err);
+  if (st != SPH_OK) {
+    sph_term t = {.data = j};
+    jst_destroy(&t);
+  }
+  return st;
+}

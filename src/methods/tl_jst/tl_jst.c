@@ -1,1 +1,501 @@
-/* placeholder: being written */
+/* tl-jst: the total-Lagrangian mixed {p,F}, {p,F,J} and {p,F,H,J} JST-SPH
+ * of seed 000 (Lee, Gil, Greto, Kulasegaram, Bonet 2016), Algorithm 1:
+ * conservation laws eq. 41 with the corrected gradient eq. 21, internal
+ * force eq. 42 (or the symmetric force of seed 003 eq. 11), JST dissipation
+ * on p and J only (eq. 35-38), angular momentum and JST projections
+ * (eq. 45-51), monolithic TVD-RK2 (eq. 43) with dt from eq. 44, essential
+ * boundary conditions imposed on particles. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/registry_impl.h"
+#include "methods/tl_jst/tl_jst_iact.h"
+#include "methods/tl_jst/tl_jst_impl.h"
+#include "sph/corrections.h"
+#include "sph/tensor.h"
+#include "terms/terms_impl.h"
+
+#define TRY(expr)                                                              \
+  do {                                                                         \
+    sph_status st_ = (expr);                                                   \
+    if (st_ != SPH_OK)                                                         \
+      return st_;                                                              \
+  } while (0)
+
+/* ---- stress and state
+ * ---------------------------------------------------------- */
+
+/* H and J of particle a for the chosen variant */
+static inline void strain_measures(const tl_jst *m, const double *F,
+                                   const double *H, const double *J, size_t a,
+                                   double Ha[9], double *Ja) {
+  const double *Fa = F + 9 * a;
+  if (m->fields == TL_JST_PFHJ)
+    memcpy(Ha, H + 9 * a, 9 * sizeof *Ha);
+  else
+    sph_mat3_cofactor(Fa, Ha);
+  *Ja = m->fields == TL_JST_PF ? sph_mat3_det(Fa) : J[a];
+}
+
+static void compute_stress(tl_jst *m, long n) {
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double Ha[9], Ja;
+    strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
+    sph_material_stress(m->mat[a], m->F + 9 * a, Ha, Ja, m->P + 9 * a);
+  }
+}
+
+/* ---- right-hand side (Algorithm 1 steps 4-8)
+ * ------------------------------------ */
+
+static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
+                             sph_error *err) {
+  tl_jst *m = ctx;
+  sph_sim *sim = m->sim;
+  const sph_neighbors *nl = m->nl;
+  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
+  long n = (long)sim->ps->n;
+  double t0 = sph_wtime();
+  compute_stress(m, n);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double G[9] = {0}, T[3] = {0, 0, 0};
+    double inv_rho0 = 1.0 / m->rho0[a];
+    const double *pa = m->p + 3 * a, *Pa = m->P + 9 * a;
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      const double *g = m->grad + 3 * k;
+      tl_jst_iact_velocity_gradient(G, V[b], inv_rho0, pa, m->p + 3 * b, g);
+      if (m->force == TL_JST_CONSERVATIVE)
+        tl_jst_iact_force(T, V[b], Pa, m->P + 9 * b, g,
+                          m->grad + 3 * m->rev[k]);
+      else
+        tl_jst_iact_force_symmetric(T, V[b], Pa, m->P + 9 * b, g);
+    }
+    /* geometric conservation laws (eq. 41b-d) and dx = p / rho0 */
+    memcpy(m->dF + 9 * a, G, sizeof G);
+    if (m->fields == TL_JST_PFHJ)
+      sph_mat3_tensor_cross(m->F + 9 * a, G, m->dH + 9 * a);
+    if (m->fields != TL_JST_PF) {
+      double Ha[9], Ja;
+      strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
+      m->dJ[a] = sph_mat3_ddot(Ha, G);
+    }
+    for (int c = 0; c < 3; ++c) {
+      m->dp[3 * a + c] = -T[c];
+      m->dx[3 * a + c] = pa[c] * inv_rho0;
+    }
+  }
+  /* X^chi of eq. 45: x^n, then x^n + dt / (2 rho0) (p^n + p*) */
+  const double *xm = m->x;
+  if (stage > 0) {
+#pragma omp parallel for schedule(static)
+    for (long a = 0; a < n; ++a)
+      for (int c = 0; c < 3; ++c)
+        m->xmoment[3 * a + c] =
+            m->x0[3 * a + c] +
+            0.5 * dt * (m->p0[3 * a + c] + m->p[3 * a + c]) / m->rho0[a];
+    xm = m->xmoment;
+  }
+  sim->timers[m->timer_force].seconds += sph_wtime() - t0;
+  sim->timers[m->timer_force].calls++;
+  sph_stage s = {.t = t,
+                 .x = m->x,
+                 .p = m->p,
+                 .F = m->F,
+                 .H = m->H,
+                 .J = m->J,
+                 .x_moment = xm,
+                 .dx = m->dx,
+                 .dp = m->dp,
+                 .dF = m->dF,
+                 .dH = m->dH,
+                 .dJ = m->dJ};
+  return sph_sim_terms_rates(sim, &s, err);
+}
+
+static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
+  tl_jst *m = ctx;
+  sph_stage s = {.t = t, .x = m->x, .p = m->p, .F = m->F, .H = m->H, .J = m->J};
+  return sph_sim_terms_constrain(m->sim, &s, err);
+}
+
+/* ---- ops
+ * ------------------------------------------------------------------------- */
+
+static double tl_jst_stable_dt(sph_sim *sim) {
+  const tl_jst *m = sim->method_data;
+  /* eq. 44 with h_min the particle spacing and the materials' c_p */
+  return m->cfl * sim->dp / m->cp;
+}
+
+static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
+  tl_jst *m = sim->method_data;
+  TRY(sph_tvd_rk2_step(&m->ode, sim->t, dt, err));
+  long n3 = 3 * (long)sim->ps->n;
+  for (long i = 0; i < n3; ++i)
+    if (!isfinite(m->p[i]) || !isfinite(m->x[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "non-finite state at particle %ld at t = %g", i / 3,
+                           sim->t + dt);
+  return SPH_OK;
+}
+
+static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
+  tl_jst *m = sim->method_data;
+  sph_particles *ps = sim->ps;
+  long n = (long)ps->n;
+  compute_stress(m, n);
+  double *X = ps->field[SPH_FIELD_POSITION0];
+  double *v = ps->field[SPH_FIELD_VELOCITY],
+         *u = ps->field[SPH_FIELD_DISPLACEMENT];
+  double *Jf = ps->field[SPH_FIELD_JACOBIAN],
+         *sig = ps->field[SPH_FIELD_STRESS];
+  double *pr = ps->field[SPH_FIELD_PRESSURE],
+         *vm = ps->field[SPH_FIELD_VON_MISES];
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    for (int c = 0; c < 3; ++c) {
+      v[3 * a + c] = m->p[3 * a + c] / m->rho0[a];
+      u[3 * a + c] = m->x[3 * a + c] - X[3 * a + c];
+    }
+    double Ha[9], Ja, S[9], Ft[9];
+    strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
+    Jf[a] = Ja;
+    /* Cauchy stress sigma = P F^T / det F */
+    sph_mat3_transpose(m->F + 9 * a, Ft);
+    sph_mat3_mul(m->P + 9 * a, Ft, S);
+    double detF = sph_mat3_det(m->F + 9 * a);
+    for (int k = 0; k < 9; ++k)
+      S[k] /= detF;
+    memcpy(sig + 9 * a, S, sizeof S);
+    double mean = sph_mat3_trace(S) / 3.0, dev2 = 0.0;
+    pr[a] = mean; /* hydrostatic pressure of seed 000 eq. 11 */
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double d = S[3 * i + j] - (i == j) * mean;
+        dev2 += d * d;
+      }
+    vm[a] = sqrt(1.5 * dev2);
+  }
+  return SPH_OK;
+}
+
+static void tl_jst_energy(sph_sim *sim, double *kinetic, double *strain) {
+  tl_jst *m = sim->method_data;
+  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
+  double ek = 0.0, es = 0.0;
+  for (size_t a = 0; a < sim->ps->n; ++a) {
+    double Ha[9], Ja;
+    strain_measures(m, m->F, m->H, m->J, a, Ha, &Ja);
+    ek += V[a] * sph_vec3_dot(m->p + 3 * a, m->p + 3 * a) / (2 * m->rho0[a]);
+    es += V[a] * sph_material_energy(m->mat[a], m->F + 9 * a, Ha, Ja);
+  }
+  *kinetic = ek;
+  *strain = es;
+}
+
+static void tl_jst_destroy(sph_sim *sim) {
+  tl_jst *m = sim->method_data;
+  if (!m)
+    return;
+  sph_neighbors_destroy(m->nl);
+  free(m->grad);
+  free(m->lap);
+  free(m->rev);
+  free(m->mat);
+  free(m->rho0);
+  free(m->x0);
+  free(m->p0);
+  free(m->F0);
+  free(m->H0);
+  free(m->J0);
+  free(m->dx);
+  free(m->dp);
+  free(m->dF);
+  free(m->dH);
+  free(m->dJ);
+  free(m->xmoment);
+  free(m);
+  sim->method_data = NULL;
+}
+
+/* ---- setup
+ * -------------------------------------------------------------------------- */
+
+static sph_status parse_choice(sph_node *opt, const char *key,
+                               const char *const *values, const char *def,
+                               int *out, sph_error *err) {
+  const char *v;
+  TRY(sph_node_get_string(opt, key, 0, def, &v, err));
+  char list[128] = "";
+  for (int i = 0; values[i]; ++i) {
+    if (!strcmp(values[i], v)) {
+      *out = i;
+      return SPH_OK;
+    }
+    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+    strncat(list, values[i], sizeof list - strlen(list) - 1);
+  }
+  return sph_node_error(sph_node_child(opt, key), err, SPH_ERR_RANGE,
+                        "'%s' is not one of: %s", v, list);
+}
+
+static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
+  *p = calloc(count ? count : 1, sizeof **p);
+  return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "tl-jst arrays");
+}
+
+/* slot of (b -> a) for every slot (a -> b): binary search in b's list */
+static sph_status reverse_slots(tl_jst *m, sph_error *err) {
+  const sph_neighbors *nl = m->nl;
+  m->rev = malloc((nl->count ? nl->count : 1) * sizeof *m->rev);
+  if (!m->rev)
+    return sph_error_set(err, SPH_ERR_NOMEM, "reverse slots");
+  long n = (long)nl->n, missing = 0;
+#pragma omp parallel for schedule(static) reduction(+ : missing)
+  for (long a = 0; a < n; ++a)
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      size_t lo = nl->offset[b], hi = nl->offset[b + 1];
+      while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (nl->index[mid] < (int32_t)a)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+      if (lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a)
+        m->rev[k] = lo;
+      else
+        ++missing;
+    }
+  if (missing)
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "neighbour lists are not "
+                         "symmetric");
+  return SPH_OK;
+}
+
+static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  static const char *const keys[] = {"name",
+                                     "fields",
+                                     "force",
+                                     "jst",
+                                     "jst_projection",
+                                     "angular_momentum_projection",
+                                     "laplacian",
+                                     "integrator",
+                                     "cfl",
+                                     "essential_bc",
+                                     NULL};
+  TRY(sph_node_check_keys(opt, keys, err));
+  tl_jst *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-jst");
+  sim->method_data = m;
+  m->sim = sim;
+  const sph_scene *s = sim->scene;
+  sph_particles *ps = sim->ps;
+  size_t n = ps->n;
+
+  /* options */
+  static const char *const fields[] = {"pF", "pFJ", "pFHJ", NULL};
+  static const char *const forces[] = {"conservative", "symmetric", NULL};
+  static const char *const laps[] = {"corrected", "gradient", NULL};
+  static const char *const integrators[] = {"tvd-rk2", NULL};
+  static const char *const bcs[] = {"direct", NULL};
+  int f, fo, lp, integ, bc, amp, jproj;
+  TRY(parse_choice(opt, "fields", fields, "pF", &f, err));
+  TRY(parse_choice(opt, "force", forces, "conservative", &fo, err));
+  TRY(parse_choice(opt, "laplacian", laps, "corrected", &lp, err));
+  TRY(parse_choice(opt, "integrator", integrators, "tvd-rk2", &integ, err));
+  TRY(parse_choice(opt, "essential_bc", bcs, "direct", &bc, err));
+  m->fields = (tl_jst_fields)f;
+  m->force = (tl_jst_force)fo;
+  TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
+  if (!(m->cfl > 0.0 && m->cfl <= 1.5))
+    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
+                          "cfl must be in (0, 1.5], got %g", m->cfl);
+  TRY(sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &amp, err));
+  TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &jproj, err));
+  sph_node *jst;
+  TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
+  if (jst->kind != SPH_NODE_MAP)
+    return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
+  static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
+                                      NULL};
+  TRY(sph_node_check_keys(jst, jkeys, err));
+  double e2p, e4p, e2j = 0.0, e4j = 0.0;
+  TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
+  TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
+  if (m->fields != TL_JST_PF) {
+    TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
+    TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
+  } else if (sph_node_child(jst, "eps2_J") || sph_node_child(jst, "eps4_J")) {
+    sph_node *bad = sph_node_child(jst, "eps2_J")
+                        ? sph_node_child(jst, "eps2_J")
+                        : sph_node_child(jst, "eps4_J");
+    return sph_node_error(bad, err, SPH_ERR_ARG,
+                          "fields pF has no J equation; use fields pFJ or "
+                          "pFHJ for JST on J");
+  }
+  double eps[4] = {e2p, e4p, e2j, e4j};
+  for (int i = 0; i < 4; ++i)
+    if (eps[i] < 0.0)
+      return sph_node_error(jst, err, SPH_ERR_RANGE,
+                            "JST coefficients must be >= 0");
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY) {
+      char key[48];
+      snprintf(key, sizeof key, "boundaries[%zu]", k);
+      return sph_error_at(err, SPH_ERR_UNSUPPORTED, s->path,
+                          s->boundaries[k].line, s->boundaries[k].col, key,
+                          "mirror (symmetry) planes are not supported by "
+                          "tl-jst yet; use a roller");
+    }
+
+  /* per-particle material, density, wave speed */
+  m->mat = malloc((n ? n : 1) * sizeof *m->mat);
+  TRY(m->mat ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "materials"));
+  TRY(alloc_zero(&m->rho0, n, err));
+  for (size_t a = 0; a < n; ++a) {
+    m->mat[a] = &s->materials[s->bodies[ps->body[a]].material];
+    m->rho0[a] = m->mat[a]->density;
+  }
+  for (size_t b = 0; b < s->nbodies; ++b) {
+    double c = sph_material_wave_speed(&s->materials[s->bodies[b].material]);
+    m->cp = c > m->cp ? c : m->cp;
+  }
+
+  /* state fields */
+  sph_field need[] = {SPH_FIELD_POSITION,  SPH_FIELD_MOMENTUM,
+                      SPH_FIELD_DEFGRAD,   SPH_FIELD_JACOBIAN,
+                      SPH_FIELD_PK1,       SPH_FIELD_DISPLACEMENT,
+                      SPH_FIELD_STRESS,    SPH_FIELD_PRESSURE,
+                      SPH_FIELD_VON_MISES, SPH_FIELD_MASS};
+  for (size_t i = 0; i < sizeof need / sizeof *need; ++i)
+    TRY(sph_particles_require(ps, need[i], err));
+  if (m->fields == TL_JST_PFHJ)
+    TRY(sph_particles_require(ps, SPH_FIELD_COFACTOR, err));
+  m->x = ps->field[SPH_FIELD_POSITION];
+  m->p = ps->field[SPH_FIELD_MOMENTUM];
+  m->F = ps->field[SPH_FIELD_DEFGRAD];
+  m->H = ps->field[SPH_FIELD_COFACTOR];
+  m->J = ps->field[SPH_FIELD_JACOBIAN];
+  m->P = ps->field[SPH_FIELD_PK1];
+  for (size_t a = 0; a < n; ++a) {
+    memcpy(m->x + 3 * a, ps->field[SPH_FIELD_POSITION0] + 3 * a,
+           3 * sizeof(double));
+    for (int c = 0; c < 3; ++c)
+      m->p[3 * a + c] = m->rho0[a] * ps->field[SPH_FIELD_VELOCITY][3 * a + c];
+    sph_mat3_identity(m->F + 9 * a);
+    if (m->H)
+      sph_mat3_identity(m->H + 9 * a);
+    m->J[a] = 1.0;
+    ps->field[SPH_FIELD_MASS][a] = m->rho0[a] * ps->field[SPH_FIELD_VOLUME0][a];
+  }
+
+  /* neighbours and corrections in the reference configuration */
+  int timer = sph_sim_add_timer(sim, "corrections");
+  double t0 = sph_wtime();
+  TRY(sph_neighbors_create(&m->nl, err));
+  TRY(sph_neighbors_build(m->nl, ps->field[SPH_FIELD_POSITION0], n,
+                          s->dimension, sim->kernel.support, ps->body,
+                          SPH_PAIRS_SAME_BODY, err));
+  TRY(reverse_slots(m, err));
+  sph_cloud cloud = {.n = n,
+                     .dim = s->dimension,
+                     .x = ps->field[SPH_FIELD_POSITION0],
+                     .volume = ps->field[SPH_FIELD_VOLUME0],
+                     .id = ps->id,
+                     .nl = m->nl,
+                     .kernel = &sim->kernel};
+  TRY(alloc_zero(&m->grad, 3 * m->nl->count, err));
+  TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, m->grad, NULL, NULL,
+                              err));
+  int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
+  if (need_p || need_j) {
+    TRY(alloc_zero(&m->lap, m->nl->count, err));
+    if (lp == 0) {
+      TRY(sph_correction_laplacian(&cloud, m->lap, err));
+    } else {
+      /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
+      const double *X = ps->field[SPH_FIELD_POSITION0];
+      for (size_t a = 0; a < n; ++a)
+        for (size_t k = m->nl->offset[a]; k < m->nl->offset[a + 1]; ++k) {
+          size_t b = (size_t)m->nl->index[k];
+          double r[3], r2 = 0.0;
+          for (int c = 0; c < 3; ++c) {
+            r[c] = X[3 * a + c] - X[3 * b + c];
+            r2 += r[c] * r[c];
+          }
+          m->lap[k] = -2.0 * sph_vec3_dot(r, m->grad + 3 * k) / r2;
+        }
+    }
+  }
+  sim->timers[timer].seconds += sph_wtime() - t0;
+  sim->timers[timer].calls++;
+  m->timer_force = sph_sim_add_timer(sim, "internal_force");
+
+  /* integrator storage */
+  size_t len[5] = {3 * n, 3 * n, 9 * n, 9 * n, n};
+  double **y[5] = {&m->x, &m->p, &m->F, &m->H, &m->J};
+  double **y0[5] = {&m->x0, &m->p0, &m->F0, &m->H0, &m->J0};
+  double **r[5] = {&m->dx, &m->dp, &m->dF, &m->dH, &m->dJ};
+  int use[5] = {1, 1, 1, m->fields == TL_JST_PFHJ, m->fields != TL_JST_PF};
+  sph_ode *ode = &m->ode;
+  for (int i = 0; i < 5; ++i) {
+    if (!use[i])
+      continue;
+    TRY(alloc_zero(y0[i], len[i], err));
+    TRY(alloc_zero(r[i], len[i], err));
+    ode->y[ode->nvec] = *y[i];
+    ode->y0[ode->nvec] = *y0[i];
+    ode->rate[ode->nvec] = *r[i];
+    ode->len[ode->nvec] = len[i];
+    ode->nvec++;
+  }
+  TRY(alloc_zero(&m->xmoment, 3 * n, err));
+  ode->rhs = tl_jst_rhs;
+  ode->constrain = tl_jst_constrain;
+  ode->ctx = m;
+
+  /* terms, only those asked for, in the order of Algorithm 1 */
+  if (amp)
+    TRY(angular_momentum_projection_create(sim, err));
+  if (need_p) {
+    jst_params jp = {m->nl, m->lap, 3, e2p, e4p, m->cp, sim->dp, jproj};
+    TRY(jst_dissipation_create(sim, &jp, err));
+  }
+  if (need_j) {
+    jst_params jp = {m->nl, m->lap, 1, e2j, e4j, m->cp, sim->dp, jproj};
+    TRY(jst_dissipation_create(sim, &jp, err));
+  }
+  if (s->has_body_force)
+    TRY(body_force_create(sim, m->rho0, err));
+  if (s->nboundaries) {
+    TRY(essential_bc_create(sim, m->rho0, err));
+    /* the initial state honours the constraints */
+    TRY(tl_jst_constrain(m, 0.0, err));
+  }
+  (void)integ;
+  (void)bc;
+  return SPH_OK;
+}
+
+const sph_method_ops tl_jst_method_ops = {
+    .name = "tl-jst",
+    .title = "Total-Lagrangian JST-SPH, mixed {p,F}/{p,F,J}/{p,F,H,J}",
+    .reference = "seed 000 (Lee et al. 2016) sec. 3-7, Algorithm 1; seed 003 "
+                 "eq. 11",
+    .setup = tl_jst_setup,
+    .stable_dt = tl_jst_stable_dt,
+    .step = tl_jst_step,
+    .derive = tl_jst_derive,
+    .energy = tl_jst_energy,
+    .destroy = tl_jst_destroy,
+};

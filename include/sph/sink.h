@@ -1,0 +1,59 @@
+/* Output sinks (DESIGN.md sec. 2, 4): each consumes the same read-only
+ * Frame at every output time; no sink recomputes physics. */
+#ifndef SPH_SINK_H
+#define SPH_SINK_H
+
+#include <stdio.h>
+
+#include "sph/sim.h"
+#include "sph/status.h"
+
+/* What a sink sees at an output time (after method->derive). */
+typedef struct sph_frame {
+  double time;
+  unsigned long step;
+  int index; /* 0, 1, ... */
+  const sph_sim *sim;
+  const sph_particles *ps;
+  double kinetic, strain; /* energies of this state */
+} sph_frame;
+
+typedef struct sph_sink sph_sink;
+typedef struct sph_sink_ops {
+  const char *name;
+  sph_status (*open)(sph_sink *sink, const sph_sim *sim, const char *dir,
+                     sph_error *err);
+  sph_status (*write)(sph_sink *sink, const sph_frame *frame, sph_error *err);
+  /* completes the files (renames them into place) */
+  sph_status (*close)(sph_sink *sink, sph_error *err);
+  void (*destroy)(sph_sink *sink);
+} sph_sink_ops;
+
+struct sph_sink {
+  const sph_sink_ops *ops;
+  void *data;
+};
+
+/* energy.csv: time, energies, linear and angular momentum */
+extern const sph_sink_ops sph_energy_sink_ops;
+/* probes.csv: the fields each probe asked for */
+extern const sph_sink_ops sph_probe_sink_ops;
+
+/* Files written under a temporary name, fsync'd and renamed on commit. */
+typedef struct sph_atomic_file {
+  FILE *f;
+  char path[1024];
+  char tmp[1040];
+} sph_atomic_file;
+
+sph_status sph_atomic_open(sph_atomic_file *af, const char *path,
+                           sph_error *err);
+sph_status sph_atomic_commit(sph_atomic_file *af, sph_error *err);
+/* Closes and removes the temporary file (safe after a failed commit). */
+void sph_atomic_abort(sph_atomic_file *af);
+
+/* Linear and angular momentum (about the origin) from mass, velocity and
+ * current position fields. */
+void sph_frame_momentum(const sph_particles *ps, double lin[3], double ang[3]);
+
+#endif

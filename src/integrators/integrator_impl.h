@@ -1,0 +1,29 @@
+/* Explicit time integrators over a list of state arrays. A method fills the
+ * rates from the current state in `rhs` and fixes the state after each
+ * update in `constrain` (prescribed values). */
+#ifndef SPH_INTEGRATOR_IMPL_H
+#define SPH_INTEGRATOR_IMPL_H
+
+#include <stddef.h>
+
+#include "sph/status.h"
+
+#define SPH_ODE_MAX 8
+
+typedef struct sph_ode {
+  int nvec;
+  double *y[SPH_ODE_MAX];    /* state, updated in place */
+  double *y0[SPH_ODE_MAX];   /* state at the start of the step */
+  double *rate[SPH_ODE_MAX]; /* rates the rhs fills */
+  size_t len[SPH_ODE_MAX];
+  /* stage = 0, 1, ...; t = stage time; dt = the step */
+  sph_status (*rhs)(void *ctx, int stage, double t, double dt, sph_error *err);
+  sph_status (*constrain)(void *ctx, double t, sph_error *err);
+  void *ctx;
+} sph_ode;
+
+/* Two-stage TVD Runge-Kutta (seed 000 eq. 43):
+ * u* = u^n + dt f(u^n); u** = u* + dt f(u*); u^{n+1} = (u^n + u**) / 2. */
+sph_status sph_tvd_rk2_step(sph_ode *ode, double t, double dt, sph_error *err);
+
+#endif

@@ -1,0 +1,39 @@
+/* Private state of the tl-jst method (seed 000). */
+#ifndef SPH_TL_JST_IMPL_H
+#define SPH_TL_JST_IMPL_H
+
+#include <stddef.h>
+
+#include "integrators/integrator_impl.h"
+#include "sph/material.h"
+#include "sph/neighbors.h"
+
+typedef enum tl_jst_fields { TL_JST_PF, TL_JST_PFJ, TL_JST_PFHJ } tl_jst_fields;
+typedef enum tl_jst_force {
+  TL_JST_CONSERVATIVE,
+  TL_JST_SYMMETRIC
+} tl_jst_force;
+
+typedef struct tl_jst {
+  tl_jst_fields fields;
+  tl_jst_force force;
+  double cfl;
+  double cp;                /* largest p-wave speed of the materials */
+  sph_neighbors *nl;        /* reference configuration, same body only */
+  double *grad;             /* corrected gradient per slot (3) */
+  double *lap;              /* Laplacian weight per slot (NULL if unused) */
+  size_t *rev;              /* slot of (b -> a) for slot (a -> b) */
+  const sph_material **mat; /* per particle */
+  double *rho0;             /* per particle */
+  /* state (particle fields) and its RK copies and rates */
+  double *x, *p, *F, *H, *J;
+  double *x0, *p0, *F0, *H0, *J0;
+  double *dx, *dp, *dF, *dH, *dJ;
+  double *P;       /* first Piola-Kirchhoff stress of the stage */
+  double *xmoment; /* X^chi of seed 000 eq. 45 */
+  sph_ode ode;
+  int timer_force;
+  struct sph_sim *sim;
+} tl_jst;
+
+#endif

@@ -1,0 +1,48 @@
+/* Terms a method composes (DESIGN.md sec. 4): each is an sph_term_ops table
+ * plus a create function that adds it to the sim only when asked for. */
+#ifndef SPH_TERMS_IMPL_H
+#define SPH_TERMS_IMPL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sph/neighbors.h"
+#include "sph/sim.h"
+
+/* Projects a per-particle vector field w (3 per particle, e.g. the internal
+ * forces) so that sum V w = 0 and sum V X x w = 0 over each body, in the
+ * least-squares sense of seed 000 eq. 46-48: w^ = w + lambda x (X - Xc) +
+ * mu. */
+void sph_momentum_projection(size_t n, const double *V, const double *X,
+                             const int32_t *body, int nbodies, double *w);
+
+/* Angular momentum projection of the internal force (seed 000 eq. 45-48):
+ * acts on stage->dp, so it must come before terms that add external or
+ * dissipative contributions. */
+sph_status angular_momentum_projection_create(sph_sim *sim, sph_error *err);
+
+/* JST dissipation (seed 000 eq. 35-38) of momentum (ncomp 3, into dp) or of
+ * the Jacobian (ncomp 1, into dJ), with the conservative projection of
+ * eq. 49 or eq. 51 when `project` is set. `lap` holds the per-slot
+ * Laplacian weights of `nl`; h is the particle spacing, cp the p-wave
+ * speed. */
+typedef struct jst_params {
+  const sph_neighbors *nl;
+  const double *lap;
+  int ncomp;
+  double eps2, eps4, cp, h;
+  int project;
+} jst_params;
+sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
+                                  sph_error *err);
+
+/* Body force E_a = rho0 g (seed 000 eq. 27c) added to dp. */
+sph_status body_force_create(sph_sim *sim, const double *rho0, sph_error *err);
+
+/* Essential boundary conditions imposed directly on particles (seed 000
+ * Algorithm 1 step 8): clamp, roller, prescribed velocity over a window.
+ * Acts on momentum per reference volume (p = rho0 v). */
+sph_status essential_bc_create(sph_sim *sim, const double *rho0,
+                               sph_error *err);
+
+#endif
