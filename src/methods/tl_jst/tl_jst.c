@@ -138,8 +138,7 @@ static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   for (long i = 0; i < n3; ++i)
     if (!isfinite(m->p[i]) || !isfinite(m->x[i]))
       return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "non-finite state at particle %ld at t = %g", i / 3,
-                           sim->t + dt);
+                           "nan: non-finite state at particle %ld", i / 3);
   return SPH_OK;
 }
 
