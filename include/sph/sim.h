@@ -24,14 +24,14 @@ typedef struct sph_term sph_term;
 /* The state a stage works on and the rates it produces (NULL when the method
  * does not carry the variable). Arrays are per particle, as in particles.h. */
 typedef struct sph_stage {
-  double t;         /* stage time */
-  const double *x;  /* positions (3) */
-  const double *p;  /* linear momentum per reference volume (3) or velocity */
-  const double *F;  /* deformation gradient (9) */
-  const double *H;  /* cofactor (9) */
-  const double *J;  /* Jacobian (1) */
-  const double *x_moment; /* positions about which angular momentum is
-                             balanced at this stage (seed 000 eq. 45) */
+  double t;        /* stage time */
+  const double *x; /* positions (3) */
+  const double *p; /* linear momentum per reference volume (3) or velocity */
+  const double *F; /* deformation gradient (9) */
+  const double *H; /* cofactor (9) */
+  const double *J; /* Jacobian (1) */
+  const double *x_moment;         /* positions about which angular momentum is
+                                     balanced at this stage (seed 000 eq. 45) */
   double *dx, *dp, *dF, *dH, *dJ; /* rates, same layouts */
 } sph_stage;
 
@@ -50,8 +50,8 @@ typedef struct sph_term_ops {
 
 struct sph_term {
   const sph_term_ops *ops;
-  void *data;           /* the term's own state */
-  double seconds;       /* wall time spent in its hooks */
+  void *data;     /* the term's own state */
+  double seconds; /* wall time spent in its hooks */
   unsigned long calls;
 };
 
@@ -122,6 +122,10 @@ int sph_sim_add_timer(sph_sim *sim, const char *name);
 sph_status sph_sim_terms_rates(sph_sim *sim, sph_stage *stage, sph_error *err);
 sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
                                    sph_error *err);
+
+/* Linear and angular momentum (about the origin) from the mass, velocity
+ * and current position fields. */
+void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]);
 
 /* Monotonic wall clock in seconds. */
 double sph_wtime(void);

@@ -52,8 +52,4 @@ sph_status sph_atomic_commit(sph_atomic_file *af, sph_error *err);
 /* Closes and removes the temporary file (safe after a failed commit). */
 void sph_atomic_abort(sph_atomic_file *af);
 
-/* Linear and angular momentum (about the origin) from mass, velocity and
- * current position fields. */
-void sph_frame_momentum(const sph_particles *ps, double lin[3], double ang[3]);
-
 #endif

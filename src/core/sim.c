@@ -3,6 +3,8 @@
  * 4). The loop calls method->stable_dt and method->step once per step. */
 #include "sph/sim.h"
 
+#include "sph/tensor.h"
+
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -136,4 +138,25 @@ sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
       return st;
   }
   return SPH_OK;
+}
+
+void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]) {
+  const double *m = ps->field[SPH_FIELD_MASS];
+  const double *v = ps->field[SPH_FIELD_VELOCITY];
+  const double *x = ps->field[SPH_FIELD_POSITION]
+                        ? ps->field[SPH_FIELD_POSITION]
+                        : ps->field[SPH_FIELD_POSITION0];
+  for (int c = 0; c < 3; ++c)
+    lin[c] = ang[c] = 0.0;
+  if (!m || !v)
+    return;
+  for (size_t a = 0; a < ps->n; ++a) {
+    double mv[3] = {m[a] * v[3 * a], m[a] * v[3 * a + 1], m[a] * v[3 * a + 2]};
+    double t[3];
+    sph_vec3_cross(x + 3 * a, mv, t);
+    for (int c = 0; c < 3; ++c) {
+      lin[c] += mv[c];
+      ang[c] += t[c];
+    }
+  }
 }

@@ -143,7 +143,7 @@ void sph_verdict_observe(sph_verdict *v, const sph_frame *fr) {
   }
   /* momentum drift */
   double lin[3], ang[3];
-  sph_frame_momentum(ps, lin, ang);
+  sph_momentum(ps, lin, ang);
   if (v->frames == 0) {
     memcpy(v->lin0, lin, sizeof lin);
     memcpy(v->ang0, ang, sizeof ang);

@@ -9,27 +9,6 @@
 #include "sph/sink.h"
 #include "sph/tensor.h"
 
-void sph_frame_momentum(const sph_particles *ps, double lin[3], double ang[3]) {
-  const double *m = ps->field[SPH_FIELD_MASS];
-  const double *v = ps->field[SPH_FIELD_VELOCITY];
-  const double *x = ps->field[SPH_FIELD_POSITION]
-                        ? ps->field[SPH_FIELD_POSITION]
-                        : ps->field[SPH_FIELD_POSITION0];
-  for (int c = 0; c < 3; ++c)
-    lin[c] = ang[c] = 0.0;
-  if (!m || !v)
-    return;
-  for (size_t a = 0; a < ps->n; ++a) {
-    double mv[3] = {m[a] * v[3 * a], m[a] * v[3 * a + 1], m[a] * v[3 * a + 2]};
-    double t[3];
-    sph_vec3_cross(x + 3 * a, mv, t);
-    for (int c = 0; c < 3; ++c) {
-      lin[c] += mv[c];
-      ang[c] += t[c];
-    }
-  }
-}
-
 static sph_status csv_close(sph_sink *sink, sph_error *err) {
   sph_atomic_file *af = sink->data;
   return sph_atomic_commit(af, err);
@@ -67,7 +46,7 @@ static sph_status energy_write(sph_sink *sink, const sph_frame *fr,
                                sph_error *err) {
   sph_atomic_file *af = sink->data;
   double lin[3], ang[3];
-  sph_frame_momentum(fr->ps, lin, ang);
+  sph_momentum(fr->ps, lin, ang);
   fprintf(af->f,
           "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
           fr->time, fr->kinetic, fr->strain, fr->kinetic + fr->strain, lin[0],

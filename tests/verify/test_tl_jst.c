@@ -1,1 +1,210 @@
-/* placeholder: being written */
+/* tl-jst (seed 000): spinning cube (B2) momentum with and without the
+ * projections of eq. 45-51, second-order energy behaviour of TVD-RK2 when
+ * no dissipation is on, agreement of the {p,F}, {p,F,J}, {p,F,H,J}
+ * variants, the term list following the scene, and option errors. */
+#include "test_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sph/scene.h"
+#include "sph/sim.h"
+
+static const char *const cube =
+    "name: spinning_cube\ndimension: 3\n"
+    "method: {name: tl-jst}\n"
+    "materials: {rubber: {model: neo-hookean, density: 1100, "
+    "youngs_modulus: 17e6, poisson_ratio: 0.3}}\n"
+    "bodies:\n  - name: cube\n    material: rubber\n"
+    "    shape: {box: {min: [-0.5, -0.5, -0.5], max: [0.5, 0.5, 0.5]}}\n"
+    "    particles: {count: [6, 6, 6]}\n"
+    "    initial_velocity: {rotation: {axis: z, omega: 105}}\n"
+    "time: {end: 0.02}\n";
+
+static sph_status make(const char *text, const char *const *sets, size_t n,
+                       sph_scene **scene, sph_sim **sim, sph_error *err) {
+  char path[64] = "/tmp/sph_jst_XXXXXX";
+  int fd = mkstemp(path);
+  ck_assert_int_ge(fd, 0);
+  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+  close(fd);
+  *sim = NULL;
+  sph_status st = sph_scene_load(scene, path, sets, n, err);
+  unlink(path);
+  if (st == SPH_OK)
+    st = sph_sim_create(sim, *scene, err);
+  return st;
+}
+
+static void run_to_end(sph_sim *sim) {
+  sph_error err;
+  while (sim->t < sim->scene->t_end * (1 - 1e-12))
+    ck_assert_int_eq(sph_sim_step(sim, sim->scene->t_end - sim->t, &err),
+                     SPH_OK);
+  ck_assert_int_eq(sim->method->derive(sim, &err), SPH_OK);
+}
+
+/* relative momentum drifts over the run; energy too */
+static void drifts(const char *const *sets, size_t n, double *lin, double *ang,
+                   double *e0, double *e1) {
+  sph_scene *s;
+  sph_sim *sim;
+  sph_error err;
+  ck_assert_msg(make(cube, sets, n, &s, &sim, &err) == SPH_OK, "%s",
+                err.message);
+  double l0[3], a0[3], l1[3], a1[3], k, w;
+  sim->method->derive(sim, &err);
+  sph_momentum(sim->ps, l0, a0);
+  sim->method->energy(sim, &k, &w);
+  *e0 = k + w;
+  run_to_end(sim);
+  sph_momentum(sim->ps, l1, a1);
+  sim->method->energy(sim, &k, &w);
+  *e1 = k + w;
+  double na = sqrt(a0[0] * a0[0] + a0[1] * a0[1] + a0[2] * a0[2]);
+  double dl = 0, da = 0;
+  for (int c = 0; c < 3; ++c) {
+    dl += (l1[c] - l0[c]) * (l1[c] - l0[c]);
+    da += (a1[c] - a0[c]) * (a1[c] - a0[c]);
+  }
+  /* linear momentum scaled by |L| / (half the cube size) */
+  *lin = sqrt(dl) / (na / 0.5);
+  *ang = sqrt(da) / na;
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+}
+
+START_TEST(spinning_cube_momentum) {
+  double lin, ang, e0, e1;
+  drifts(NULL, 0, &lin, &ang, &e0, &e1);
+  printf("B2 6^3 to 0.02 s, projections on: linear %.3g, angular %.3g\n", lin,
+         ang);
+  ck_assert_msg(ang <= 1e-10, "angular momentum drift %g", ang);
+  ck_assert_msg(lin <= 1e-12, "linear momentum drift %g", lin);
+  const char *off[] = {"method.angular_momentum_projection=false",
+                       "method.jst_projection=false"};
+  double lin2, ang2;
+  drifts(off, 2, &lin2, &ang2, &e0, &e1);
+  printf("B2 6^3 to 0.02 s, projections off: linear %.3g, angular %.3g\n", lin2,
+         ang2);
+  ck_assert_msg(ang2 > 1e3 * fmax(ang, 1e-16),
+                "without projection the drift (%g) should show", ang2);
+}
+END_TEST
+
+START_TEST(energy_is_second_order_without_dissipation) {
+  /* no JST, no projection: the scheme is conservative in space and the
+   * energy error comes from TVD-RK2, O(dt^2) */
+  double d[2];
+  const char *cfl[2] = {"method.cfl=0.2", "method.cfl=0.1"};
+  for (int i = 0; i < 2; ++i) {
+    const char *sets[] = {"method.jst.eps4_p=0",
+                          "method.angular_momentum_projection=false", cfl[i]};
+    double lin, ang, e0, e1;
+    drifts(sets, 3, &lin, &ang, &e0, &e1);
+    d[i] = fabs(e1 - e0) / e0;
+  }
+  printf("energy drift without dissipation: %.3g (cfl 0.2), %.3g (cfl 0.1), "
+         "ratio %.2f\n",
+         d[0], d[1], d[0] / d[1]);
+  ck_assert_msg(d[0] / d[1] > 3.0,
+                "energy drift ratio %g is not second "
+                "order",
+                d[0] / d[1]);
+  ck_assert(d[0] < 1e-2);
+}
+END_TEST
+
+START_TEST(variants_agree) {
+  const char *variants[3] = {"method.fields=pF", "method.fields=pFJ",
+                             "method.fields=pFHJ"};
+  double v[3][3 * 216];
+  for (int i = 0; i < 3; ++i) {
+    sph_scene *s;
+    sph_sim *sim;
+    sph_error err;
+    ck_assert(make(cube, &variants[i], 1, &s, &sim, &err) == SPH_OK);
+    run_to_end(sim);
+    memcpy(v[i], sim->ps->field[SPH_FIELD_VELOCITY], sizeof v[i]);
+    sph_sim_destroy(sim);
+    sph_scene_destroy(s);
+  }
+  for (int i = 1; i < 3; ++i) {
+    double num = 0, den = 0;
+    for (int k = 0; k < 3 * 216; ++k) {
+      num += pow(v[i][k] - v[0][k], 2);
+      den += v[0][k] * v[0][k];
+    }
+    printf("%s vs pF: relative velocity difference %.3g\n", variants[i],
+           sqrt(num / den));
+    ck_assert(sqrt(num / den) < 1e-2);
+  }
+}
+END_TEST
+
+START_TEST(terms_follow_the_scene) {
+  sph_scene *s;
+  sph_sim *sim;
+  sph_error err;
+  const char *none[] = {"method.jst.eps4_p=0",
+                        "method.angular_momentum_projection=false"};
+  ck_assert(make(cube, none, 2, &s, &sim, &err) == SPH_OK);
+  ck_assert_int_eq(sim->nterms, 0);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "%sbody_force: [0, -9.81, 0]\nboundaries: [{name: base, select: "
+           "{plane: {axis: y, at: -0.5}}, clamp: true}]\n",
+           cube);
+  const char *all[] = {"method.fields=pFJ", "method.jst.eps4_J=0.03125"};
+  ck_assert(make(text, all, 2, &s, &sim, &err) == SPH_OK);
+  const char *names[] = {"angular_momentum_projection", "jst_dissipation_p",
+                         "jst_dissipation_J", "body_force", "essential_bc"};
+  ck_assert_int_eq(sim->nterms, 5);
+  for (int i = 0; i < 5; ++i)
+    ck_assert_str_eq(sim->terms[i].ops->name, names[i]);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+}
+END_TEST
+
+START_TEST(option_errors) {
+  sph_scene *s = NULL;
+  sph_sim *sim;
+  sph_error err;
+  const char *typo[] = {"method.feilds=pF"};
+  ck_assert_int_eq(make(cube, typo, 1, &s, &sim, &err), SPH_ERR_UNKNOWN_KEY);
+  ck_assert_ptr_nonnull(strstr(err.message, "did you mean 'fields'"));
+  sph_scene_destroy(s);
+  const char *bad[] = {"method.fields=pQ"};
+  ck_assert_int_eq(make(cube, bad, 1, &s, &sim, &err), SPH_ERR_RANGE);
+  ck_assert_str_eq(err.key, "method.fields");
+  ck_assert_ptr_nonnull(strstr(err.message, "pFHJ"));
+  sph_scene_destroy(s);
+  const char *jpf[] = {"method.jst.eps4_J=0.1"};
+  ck_assert_int_eq(make(cube, jpf, 1, &s, &sim, &err), SPH_ERR_ARG);
+  sph_scene_destroy(s);
+  const char *name[] = {"method.name=tl-jts"};
+  ck_assert_int_eq(make(cube, name, 1, &s, &sim, &err), SPH_ERR_ARG);
+  ck_assert_ptr_nonnull(strstr(err.message, "did you mean 'tl-jst'"));
+  sph_scene_destroy(s);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("tl_jst");
+  TCase *tc = tcase_create("tl_jst");
+  tcase_set_timeout(tc, 300);
+  tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
+  tcase_add_test(tc, spinning_cube_momentum);
+  tcase_add_test(tc, energy_is_second_order_without_dissipation);
+  tcase_add_test(tc, variants_agree);
+  tcase_add_test(tc, terms_follow_the_scene);
+  tcase_add_test(tc, option_errors);
+  suite_add_tcase(s, tc);
+  return sph_test_run(s);
+}
