@@ -14,8 +14,7 @@ typedef struct sph_expr sph_expr;
  * variable other than x, y, z, t. */
 sph_status sph_expr_create(sph_expr **out, const char *text, sph_error *err);
 void sph_expr_destroy(sph_expr *e);
-double sph_expr_eval(const sph_expr *e, double x, double y, double z,
-                     double t);
+double sph_expr_eval(const sph_expr *e, double x, double y, double z, double t);
 const char *sph_expr_text(const sph_expr *e);
 
 #endif

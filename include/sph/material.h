@@ -34,9 +34,9 @@ struct sph_material {
   double density; /* reference density rho0, kg/m^3 */
   double youngs_modulus;
   double poisson_ratio;
-  double mu;      /* shear modulus */
-  double lambda;  /* first Lame parameter */
-  double kappa;   /* bulk modulus */
+  double mu;       /* shear modulus */
+  double lambda;   /* first Lame parameter */
+  double kappa;    /* bulk modulus */
   double varsigma; /* Mooney-Rivlin (seed 000 eq. 8) */
   double xi;
 };

@@ -47,8 +47,7 @@ sph_node *sph_node_child(const sph_node *map, const char *key);
 /* Applies "a.b.c=value" (the value is parsed as YAML, so "[1,2,3]" is a
  * sequence); a numeric part indexes a sequence ("bodies.0.material=steel").
  * Missing map keys are created; the new nodes carry origin "<command line>". */
-sph_status sph_node_set(sph_node *root, const char *assignment,
-                        sph_error *err);
+sph_status sph_node_set(sph_node *root, const char *assignment, sph_error *err);
 
 /* Every key of `map` must be in `allowed` (NULL-terminated); the first that
  * is not gives SPH_ERR_UNKNOWN_KEY with a "did you mean" suggestion. */

@@ -46,13 +46,13 @@ enum {
 };
 
 typedef struct sph_particles {
-  size_t n;         /* particles in use */
-  size_t capacity;  /* particles allocated */
-  int dim;          /* 2 or 3 (storage is always 3 components) */
+  size_t n;                       /* particles in use */
+  size_t capacity;                /* particles allocated */
+  int dim;                        /* 2 or 3 (storage is always 3 components) */
   double *field[SPH_FIELD_COUNT]; /* NULL until required */
-  int64_t *id;      /* stable particle id, 0..n-1 at creation */
-  int32_t *body;    /* index of the body in the scene */
-  uint32_t *flags;  /* SPH_FLAG_* */
+  int64_t *id;                    /* stable particle id, 0..n-1 at creation */
+  int32_t *body;                  /* index of the body in the scene */
+  uint32_t *flags;                /* SPH_FLAG_* */
 } sph_particles;
 
 const char *sph_field_name(sph_field f);

@@ -47,14 +47,14 @@ typedef enum sph_lattice {
 typedef enum sph_distribution {
   SPH_DIST_LATTICE,
   SPH_DIST_JITTER, /* lattice moved by a uniform random offset */
-  SPH_DIST_RELAX   /* lattice jittered then relaxed to a uniform irregular set */
+  SPH_DIST_RELAX /* lattice jittered then relaxed to a uniform irregular set */
 } sph_distribution;
 
 typedef enum sph_velocity_kind {
   SPH_VEL_NONE,
-  SPH_VEL_UNIFORM,    /* value */
-  SPH_VEL_ROTATION,   /* v = (omega profile(X)) axis x (X - center) */
-  SPH_VEL_EXPRESSION  /* three expressions of x, y, z (reference coords) */
+  SPH_VEL_UNIFORM,   /* value */
+  SPH_VEL_ROTATION,  /* v = (omega profile(X)) axis x (X - center) */
+  SPH_VEL_EXPRESSION /* three expressions of x, y, z (reference coords) */
 } sph_velocity_kind;
 
 typedef struct sph_expr sph_expr; /* see expr.h */
@@ -65,8 +65,8 @@ typedef struct sph_velocity {
   int axis;
   double omega;
   double center[3];
-  sph_expr *profile;   /* rotation profile, NULL = 1 */
-  sph_expr *expr[3];   /* expression components */
+  sph_expr *profile; /* rotation profile, NULL = 1 */
+  sph_expr *expr[3]; /* expression components */
 } sph_velocity;
 
 typedef struct sph_body {
@@ -77,7 +77,7 @@ typedef struct sph_body {
   int count[3];   /* SPH_LATTICE_FACES */
   double spacing; /* dp (derived from count for FACES: the smallest L/(n-1)) */
   sph_distribution distribution;
-  double jitter;  /* fraction of dp */
+  double jitter; /* fraction of dp */
   unsigned long seed;
   int relax_steps;
   sph_velocity velocity;
@@ -101,11 +101,11 @@ typedef struct sph_selection {
 } sph_selection;
 
 typedef enum sph_condition_kind {
-  SPH_BC_CLAMP,    /* all velocity components fixed to zero */
-  SPH_BC_ROLLER,   /* normal component fixed to zero (symmetry plane) */
-  SPH_BC_VELOCITY, /* velocity prescribed over [from, until) */
-  SPH_BC_SYMMETRY, /* mirror plane: ghosts reflect positions, negate the
-                      normal velocity component (BENCHMARKS D.1) */
+  SPH_BC_CLAMP,        /* all velocity components fixed to zero */
+  SPH_BC_ROLLER,       /* normal component fixed to zero (symmetry plane) */
+  SPH_BC_VELOCITY,     /* velocity prescribed over [from, until) */
+  SPH_BC_SYMMETRY,     /* mirror plane: ghosts reflect positions, negate the
+                          normal velocity component (BENCHMARKS D.1) */
   SPH_BC_SKEW_SYMMETRY /* mirror plane: ghosts negate the tangential
                           components */
 } sph_condition_kind;
@@ -114,9 +114,9 @@ typedef struct sph_boundary {
   char name[SPH_NAME_MAX];
   sph_selection select;
   sph_condition_kind kind;
-  int axis;         /* roller / symmetry plane normal */
-  double value[3];  /* prescribed velocity */
-  unsigned mask;    /* components prescribed (bits 0..2) */
+  int axis;        /* roller / symmetry plane normal */
+  double value[3]; /* prescribed velocity */
+  unsigned mask;   /* components prescribed (bits 0..2) */
   double from, until;
   int line, col;
 } sph_boundary;
@@ -140,7 +140,7 @@ typedef struct sph_camera {
 typedef struct sph_png_output {
   int enabled;
   int width, height;
-  int color_field; /* sph_field */
+  int color_field;     /* sph_field */
   char range_mode[16]; /* auto | symmetric | fixed | global */
   double range[2];
   sph_camera camera;
@@ -163,8 +163,8 @@ typedef struct sph_scene {
   char name[SPH_NAME_MAX];
   char path[512];
   int dimension;
-  sph_node *root;   /* the resolved tree (defaults filled) */
-  sph_node *method; /* the method block, validated by the method */
+  sph_node *root;      /* the resolved tree (defaults filled) */
+  sph_node *method;    /* the method block, validated by the method */
   sph_node *reference; /* optional `reference:` block (analytic solution or
                           scalar reference), validated by its user; NULL */
   char method_name[SPH_NAME_MAX];

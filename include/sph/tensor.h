@@ -59,8 +59,8 @@ static inline void sph_mat3_mul(const double A[9], const double B[9],
   double t[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      t[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] +
-                     A[3 * i + 2] * B[6 + j];
+      t[3 * i + j] =
+          A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
   memcpy(C, t, sizeof t);
 }
 

@@ -102,8 +102,8 @@ sph_status sph_particles_append(sph_particles *ps, const double X[3],
 }
 
 size_t sph_particles_bytes(const sph_particles *ps) {
-  size_t bytes = ps->capacity * (sizeof *ps->id + sizeof *ps->body +
-                                 sizeof *ps->flags);
+  size_t bytes =
+      ps->capacity * (sizeof *ps->id + sizeof *ps->body + sizeof *ps->flags);
   for (int f = 0; f < SPH_FIELD_COUNT; ++f)
     if (ps->field[f])
       bytes += ps->capacity * (size_t)field_ncomp[f] * sizeof(double);

@@ -1,2 +1,71 @@
 #!/usr/bin/env bash
-echo "placeholder"; exit 1
+# Command-line behaviour: every bad scene in bad/ is refused by `sph check`
+# and `sph run` with exit status 2, the message its first line expects
+# ("# expect: LINE:COL: key: message") on stderr, and nothing written; plus
+# usage errors, a tiny end-to-end run and the --overwrite guard.
+set -u
+sph=$1
+src=$2
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+
+for f in "$here"/bad/*.yaml; do
+  name=$(basename "$f" .yaml)
+  expect=$(head -1 "$f" | sed 's/^# expect: //')
+  for cmd in check run; do
+    out="$work/out_$name"
+    if [ "$cmd" = run ]; then
+      "$sph" run "$f" --out "$out" >"$work/stdout" 2>"$work/stderr"
+    else
+      "$sph" check "$f" >"$work/stdout" 2>"$work/stderr"
+    fi
+    rc=$?
+    if [ $rc -ne 2 ]; then
+      bad "$name ($cmd): exit $rc, expected 2: $(cat "$work/stderr")"
+    elif ! grep -qF "$f:$expect" "$work/stderr"; then
+      bad "$name ($cmd): expected '$f:$expect', got: $(cat "$work/stderr")"
+    elif [ -e "$out" ]; then
+      bad "$name ($cmd): wrote $out"
+    else
+      ok
+    fi
+  done
+done
+
+# a missing file, a bad --set and usage errors
+"$sph" check "$work/none.yaml" 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "$work/none.yaml" "$work/stderr" && ok || bad "missing file"
+"$sph" check "$src/scenes/twisting_column.yaml" --set materials.rubber.poisson=0.4 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "did you mean 'poisson_ratio'" "$work/stderr" && ok || bad "--set typo: $(cat "$work/stderr")"
+"$sph" check "$src/scenes/twisting_column.yaml" --set bodies.3.name=x 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "past the end" "$work/stderr" && ok || bad "--set index: $(cat "$work/stderr")"
+"$sph" frobnicate 2>/dev/null
+[ $? -eq 2 ] && ok || bad "unknown command"
+"$sph" run --threads 0 2>/dev/null
+[ $? -eq 2 ] && ok || bad "bad --threads"
+
+# a tiny run end to end, then the overwrite guard
+tiny="$work/tiny.yaml"
+sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
+  -e 's/every: 0.005/every: 0.005/' "$src/scenes/twisting_column.yaml" >"$tiny"
+"$sph" run "$tiny" --out "$work/run" --quiet >"$work/stdout" 2>&1
+rc=$?
+if [ $rc -eq 0 ] && [ -f "$work/run/summary.json" ] && [ -f "$work/run/energy.csv" ] &&
+  [ -f "$work/run/probes.csv" ] && [ -f "$work/run/scene_used.yaml" ] &&
+  [ "$(wc -l <"$work/run/energy.csv")" -eq 6 ] && ! ls "$work/run"/*.part >/dev/null 2>&1; then
+  ok
+else
+  bad "tiny run (exit $rc): $(cat "$work/stdout"); $(ls "$work/run" 2>&1)"
+fi
+"$sph" check "$work/run/scene_used.yaml" >/dev/null 2>&1 && ok || bad "scene_used.yaml does not load back"
+"$sph" run "$tiny" --out "$work/run" --quiet >/dev/null 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF -- "--overwrite" "$work/stderr" && ok || bad "second run without --overwrite"
+"$sph" run "$tiny" --out "$work/run" --quiet --overwrite >/dev/null 2>&1 && ok || bad "--overwrite"
+
+echo "$pass passed, $fail failed"
+[ $fail -eq 0 ]

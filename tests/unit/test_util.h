@@ -2,7 +2,6 @@
 #ifndef SPH_TEST_UTIL_H
 #define SPH_TEST_UTIL_H
 
-
 #include <check.h>
 #include <fenv.h>
 #include <stdlib.h>
