@@ -57,6 +57,14 @@ sph_status sph_error_at(sph_error *err, sph_status code, const char *file,
                         int line, int col, const char *key, const char *fmt,
                         ...) __attribute__((format(printf, 7, 8)));
 
+/* Returns from the calling function when `expr` is not SPH_OK. */
+#define SPH_TRY(expr)                                                          \
+  do {                                                                         \
+    sph_status sph_try_status_ = (expr);                                       \
+    if (sph_try_status_ != SPH_OK)                                             \
+      return sph_try_status_;                                                  \
+  } while (0)
+
 /* Writes "file:line:col: key: message" (parts present only) into buf. */
 void sph_error_format(const sph_error *err, char *buf, size_t size);
 

@@ -36,6 +36,13 @@ const char *sph_app_default_scene(void);
 /* Prints "sph: file:line:col: key: message" to stderr. */
 void sph_app_print_error(const sph_error *err);
 
+struct sph_scene;
+struct sph_sim;
+/* Loads the scene with its overrides and creates the simulation; prints the
+ * error and returns SPH_EXIT_USAGE on bad input. */
+int sph_app_load(const sph_app_args *args, const char *path,
+                 struct sph_scene **scene, struct sph_sim **sim);
+
 int sph_cmd_run(int argc, char **argv);
 int sph_cmd_check(int argc, char **argv);
 int sph_cmd_list(int argc, char **argv);

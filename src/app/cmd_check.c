@@ -58,19 +58,10 @@ int sph_cmd_check(int argc, char **argv) {
                     "[--set k=v]...)\n");
     return SPH_EXIT_USAGE;
   }
-  sph_error err;
-  sph_error_clear(&err);
-  sph_scene *scene = NULL;
-  sph_sim *sim = NULL;
-  sph_status st =
-      sph_scene_load(&scene, args.scene, args.sets, args.nsets, &err);
-  if (st == SPH_OK)
-    st = sph_sim_create(&sim, scene, &err);
-  if (st != SPH_OK) {
-    sph_app_print_error(&err);
-    sph_scene_destroy(scene);
-    return SPH_EXIT_USAGE;
-  }
+  sph_scene *scene;
+  sph_sim *sim;
+  if ((rc = sph_app_load(&args, args.scene, &scene, &sim)) != SPH_EXIT_OK)
+    return rc;
   print_plan(scene, sim);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);

@@ -121,18 +121,13 @@ int sph_cmd_run(int argc, char **argv) {
   if (rc != SPH_EXIT_OK)
     return rc;
   const char *path = args.scene ? args.scene : sph_app_default_scene();
+  sph_scene *scene;
+  sph_sim *sim;
+  if ((rc = sph_app_load(&args, path, &scene, &sim)) != SPH_EXIT_OK)
+    return rc;
   sph_error err;
   sph_error_clear(&err);
-  sph_scene *scene = NULL;
-  sph_sim *sim = NULL;
-  sph_status st = sph_scene_load(&scene, path, args.sets, args.nsets, &err);
-  if (st == SPH_OK)
-    st = sph_sim_create(&sim, scene, &err);
-  if (st != SPH_OK) {
-    sph_app_print_error(&err);
-    sph_scene_destroy(scene);
-    return SPH_EXIT_USAGE;
-  }
+  sph_status st = SPH_OK;
   char dir[1024];
   if (args.out)
     snprintf(dir, sizeof dir, "%s", args.out);

@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "app/app_impl.h"
+#include "sph/scene.h"
+#include "sph/sim.h"
 
 static void usage(FILE *out) {
   fprintf(out, "usage: sph <command> [options]\n"
@@ -90,6 +92,23 @@ int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
   if (args->threads > 0)
     omp_set_num_threads(args->threads);
   return SPH_EXIT_OK;
+}
+
+int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
+                 sph_sim **sim) {
+  sph_error err;
+  sph_error_clear(&err);
+  *scene = NULL;
+  *sim = NULL;
+  sph_status st = sph_scene_load(scene, path, args->sets, args->nsets, &err);
+  if (st == SPH_OK)
+    st = sph_sim_create(sim, *scene, &err);
+  if (st == SPH_OK)
+    return SPH_EXIT_OK;
+  sph_app_print_error(&err);
+  sph_scene_destroy(*scene);
+  *scene = NULL;
+  return SPH_EXIT_USAGE;
 }
 
 int main(int argc, char **argv) {

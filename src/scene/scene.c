@@ -14,13 +14,6 @@
 #include "sph/geometry.h"
 #include "sph/neighbors.h"
 
-#define TRY(expr)                                                              \
-  do {                                                                         \
-    sph_status st_ = (expr);                                                   \
-    if (st_ != SPH_OK)                                                         \
-      return st_;                                                              \
-  } while (0)
-
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 
 /* ---- small readers
@@ -48,7 +41,7 @@ static sph_status get_seq(sph_node *map, const char *key, int required,
 static sph_status get_axis(sph_node *map, const char *key, int required,
                            int def, int *out, sph_error *err) {
   const char *name;
-  TRY(sph_node_get_string(map, key, required, axis_names[def], &name, err));
+  SPH_TRY(sph_node_get_string(map, key, required, axis_names[def], &name, err));
   for (int a = 0; a < 3; ++a)
     if (!strcmp(name, axis_names[a])) {
       *out = a;
@@ -60,7 +53,7 @@ static sph_status get_axis(sph_node *map, const char *key, int required,
 
 static sph_status positive(sph_node *map, const char *key, int required,
                            double def, double *out, sph_error *err) {
-  TRY(sph_node_get_double(map, key, required, def, out, err));
+  SPH_TRY(sph_node_get_double(map, key, required, def, out, err));
   if (!(*out > 0.0))
     return sph_node_error(sph_node_child(map, key), err, SPH_ERR_RANGE,
                           "must be positive, got %g", *out);
@@ -98,13 +91,13 @@ static void copy_name(char *dst, const char *src) {
 
 static sph_status parse_kernel(sph_scene *s, sph_node *root, sph_error *err) {
   sph_node *k;
-  TRY(sph_node_insert_default(root, "kernel", "{}", &k, err));
+  SPH_TRY(sph_node_insert_default(root, "kernel", "{}", &k, err));
   if (k->kind != SPH_NODE_MAP)
     return sph_node_error(k, err, SPH_ERR_TYPE, "expected a mapping");
   static const char *const keys[] = {"type", "h_over_dp", NULL};
-  TRY(sph_node_check_keys(k, keys, err));
+  SPH_TRY(sph_node_check_keys(k, keys, err));
   const char *type;
-  TRY(sph_node_get_string(k, "type", 0, "cubic", &type, err));
+  SPH_TRY(sph_node_get_string(k, "type", 0, "cubic", &type, err));
   int t = sph_kernel_type_from_name(type);
   if (t < 0)
     return sph_node_error(sph_node_child(k, "type"), err, SPH_ERR_RANGE,
@@ -112,7 +105,7 @@ static sph_status parse_kernel(sph_scene *s, sph_node *root, sph_error *err) {
                           "wendland-c2, wendland-c4)",
                           type);
   s->kernel_type = (sph_kernel_type)t;
-  TRY(sph_node_get_double(k, "h_over_dp", 0, 1.3, &s->h_over_dp, err));
+  SPH_TRY(sph_node_get_double(k, "h_over_dp", 0, 1.3, &s->h_over_dp, err));
   if (!(s->h_over_dp >= 0.8 && s->h_over_dp <= 4.0))
     return sph_node_error(sph_node_child(k, "h_over_dp"), err, SPH_ERR_RANGE,
                           "must be in [0.8, 4], got %g", s->h_over_dp);
@@ -132,9 +125,9 @@ static sph_status parse_material(sph_material *m, const char *name, sph_node *n,
                                      "bulk_modulus",
                                      "xi",
                                      NULL};
-  TRY(sph_node_check_keys(n, keys, err));
+  SPH_TRY(sph_node_check_keys(n, keys, err));
   sph_material_params p = {0};
-  TRY(sph_node_get_string(n, "model", 0, "neo-hookean", &p.model, err));
+  SPH_TRY(sph_node_get_string(n, "model", 0, "neo-hookean", &p.model, err));
   int known = 0;
   for (const char *const *mname = sph_material_models(); *mname; ++mname)
     known |= !strcmp(*mname, p.model);
@@ -148,7 +141,7 @@ static sph_status parse_material(sph_material *m, const char *name, sph_node *n,
                                  "mooney-rivlin)",
                           hint ? hint : "", hint ? "'?" : "");
   }
-  TRY(positive(n, "density", 1, 0, &p.density, err));
+  SPH_TRY(positive(n, "density", 1, 0, &p.density, err));
   p.has_youngs =
       sph_node_child(n, "youngs_modulus") || sph_node_child(n, "poisson_ratio");
   p.has_moduli =
@@ -162,19 +155,20 @@ static sph_status parse_material(sph_material *m, const char *name, sph_node *n,
                           "give youngs_modulus and poisson_ratio (or "
                           "shear_modulus and bulk_modulus)");
   if (p.has_youngs) {
-    TRY(positive(n, "youngs_modulus", 1, 0, &p.youngs_modulus, err));
-    TRY(sph_node_get_double(n, "poisson_ratio", 1, 0, &p.poisson_ratio, err));
+    SPH_TRY(positive(n, "youngs_modulus", 1, 0, &p.youngs_modulus, err));
+    SPH_TRY(
+        sph_node_get_double(n, "poisson_ratio", 1, 0, &p.poisson_ratio, err));
     if (!(p.poisson_ratio > -1.0 && p.poisson_ratio < 0.5))
       return sph_node_error(sph_node_child(n, "poisson_ratio"), err,
                             SPH_ERR_RANGE, "must be in (-1, 0.5), got %g",
                             p.poisson_ratio);
   } else {
-    TRY(positive(n, "shear_modulus", 1, 0, &p.shear_modulus, err));
-    TRY(positive(n, "bulk_modulus", 1, 0, &p.bulk_modulus, err));
+    SPH_TRY(positive(n, "shear_modulus", 1, 0, &p.shear_modulus, err));
+    SPH_TRY(positive(n, "bulk_modulus", 1, 0, &p.bulk_modulus, err));
   }
   if (sph_node_child(n, "xi")) {
     p.has_xi = 1;
-    TRY(sph_node_get_double(n, "xi", 1, 0, &p.xi, err));
+    SPH_TRY(sph_node_get_double(n, "xi", 1, 0, &p.xi, err));
   }
   sph_status st = sph_material_create(m, &p, err);
   if (st != SPH_OK) {
@@ -190,7 +184,7 @@ static sph_status parse_material(sph_material *m, const char *name, sph_node *n,
 static sph_status parse_materials(sph_scene *s, sph_node *root,
                                   sph_error *err) {
   sph_node *mats;
-  TRY(sph_node_get_map(root, "materials", 1, &mats, err));
+  SPH_TRY(sph_node_get_map(root, "materials", 1, &mats, err));
   if (mats->count == 0)
     return sph_node_error(mats, err, SPH_ERR_MISSING_KEY,
                           "define at least one material");
@@ -198,7 +192,8 @@ static sph_status parse_materials(sph_scene *s, sph_node *root,
   if (!s->materials)
     return sph_error_set(err, SPH_ERR_NOMEM, "materials");
   for (size_t i = 0; i < mats->count; ++i) {
-    TRY(parse_material(&s->materials[i], mats->keys[i], mats->items[i], err));
+    SPH_TRY(
+        parse_material(&s->materials[i], mats->keys[i], mats->items[i], err));
     mats->items[i]->used = 1;
     s->nmaterials++;
   }
@@ -211,23 +206,23 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                                       "sphere", "shell",    NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
-  TRY(sph_node_check_keys(n, kinds, err));
+  SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
-  TRY(one_of(n, kinds, "shape", &which, err));
+  SPH_TRY(one_of(n, kinds, "shape", &which, err));
   static const sph_shape_kind map[] = {SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER,
                                        SPH_SHAPE_RING,   SPH_SHAPE_DISC,
                                        SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL};
   memset(sh, 0, sizeof *sh);
   sh->kind = map[which];
   sph_node *g;
-  TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
+  SPH_TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
   int d = s->dimension;
   switch (sh->kind) {
   case SPH_SHAPE_BOX: {
     static const char *const keys[] = {"min", "max", NULL};
-    TRY(sph_node_check_keys(g, keys, err));
-    TRY(sph_node_get_doubles(g, "min", 1, (size_t)d, sh->min, NULL, err));
-    TRY(sph_node_get_doubles(g, "max", 1, (size_t)d, sh->max, NULL, err));
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(sph_node_get_doubles(g, "min", 1, (size_t)d, sh->min, NULL, err));
+    SPH_TRY(sph_node_get_doubles(g, "max", 1, (size_t)d, sh->max, NULL, err));
     for (int c = 0; c < d; ++c)
       if (!(sh->max[c] > sh->min[c]))
         return sph_node_error(sph_node_child(g, "max"), err, SPH_ERR_GEOMETRY,
@@ -239,10 +234,11 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   case SPH_SHAPE_DISC:
   case SPH_SHAPE_SPHERE: {
     static const char *const keys[] = {"center", "radius", NULL};
-    TRY(sph_node_check_keys(g, keys, err));
-    TRY(sph_node_get_doubles(g, "center", 1, (size_t)d, sh->center, NULL, err));
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(
+        sph_node_get_doubles(g, "center", 1, (size_t)d, sh->center, NULL, err));
     sph_node *r = sph_node_child(g, "radius");
-    TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
+    SPH_TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
     if (!(sh->radius > 0))
       return sph_node_error(r, err, SPH_ERR_GEOMETRY,
                             "empty shape: radius must be positive, got %g",
@@ -252,15 +248,15 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   case SPH_SHAPE_CYLINDER: {
     static const char *const keys[] = {"center", "axis", "radius", "length",
                                        NULL};
-    TRY(sph_node_check_keys(g, keys, err));
-    TRY(sph_node_get_doubles(g, "center", 1, 3, sh->center, NULL, err));
-    TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
-    TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(sph_node_get_doubles(g, "center", 1, 3, sh->center, NULL, err));
+    SPH_TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
+    SPH_TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
     if (!(sh->radius > 0))
       return sph_node_error(sph_node_child(g, "radius"), err, SPH_ERR_GEOMETRY,
                             "empty shape: radius must be positive, got %g",
                             sh->radius);
-    TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
+    SPH_TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
     if (!(sh->length > 0))
       return sph_node_error(sph_node_child(g, "length"), err, SPH_ERR_GEOMETRY,
                             "empty shape: length must be positive, got %g",
@@ -274,11 +270,13 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                                         "outer_radius", NULL};
     static const char *const keys3[] = {
         "center", "inner_radius", "outer_radius", "axis", "length", NULL};
-    TRY(sph_node_check_keys(g, tube ? keys3 : keys2, err));
-    TRY(sph_node_get_doubles(g, "center", 1, tube ? 3 : (size_t)d, sh->center,
-                             NULL, err));
-    TRY(sph_node_get_double(g, "inner_radius", 1, 0, &sh->inner_radius, err));
-    TRY(sph_node_get_double(g, "outer_radius", 1, 0, &sh->outer_radius, err));
+    SPH_TRY(sph_node_check_keys(g, tube ? keys3 : keys2, err));
+    SPH_TRY(sph_node_get_doubles(g, "center", 1, tube ? 3 : (size_t)d,
+                                 sh->center, NULL, err));
+    SPH_TRY(
+        sph_node_get_double(g, "inner_radius", 1, 0, &sh->inner_radius, err));
+    SPH_TRY(
+        sph_node_get_double(g, "outer_radius", 1, 0, &sh->outer_radius, err));
     if (!(sh->inner_radius >= 0 && sh->outer_radius > sh->inner_radius))
       return sph_node_error(sph_node_child(g, "outer_radius"), err,
                             SPH_ERR_GEOMETRY,
@@ -286,8 +284,8 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                             "outer_radius, got %g and %g",
                             sh->inner_radius, sh->outer_radius);
     if (tube) {
-      TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
-      TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
+      SPH_TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
+      SPH_TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
       if (!(sh->length > 0))
         return sph_node_error(
             sph_node_child(g, "length"), err, SPH_ERR_GEOMETRY,
@@ -312,10 +310,10 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
   static const char *const keys[] = {"count",  "spacing", "distribution",
                                      "jitter", "seed",    "relax_steps",
                                      NULL};
-  TRY(sph_node_check_keys(n, keys, err));
+  SPH_TRY(sph_node_check_keys(n, keys, err));
   static const char *const how[] = {"count", "spacing", NULL};
   int which;
-  TRY(one_of(n, how, "of count or spacing", &which, err));
+  SPH_TRY(one_of(n, how, "of count or spacing", &which, err));
   int d = s->dimension;
   if (which == 0) {
     if (b->shape.kind != SPH_SHAPE_BOX)
@@ -323,7 +321,7 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
                             "particle counts apply to boxes; give a spacing "
                             "for other shapes");
     double c[3];
-    TRY(sph_node_get_doubles(n, "count", 1, (size_t)d, c, NULL, err));
+    SPH_TRY(sph_node_get_doubles(n, "count", 1, (size_t)d, c, NULL, err));
     b->lattice = SPH_LATTICE_FACES;
     b->spacing = INFINITY;
     for (int k = 0; k < d; ++k) {
@@ -338,11 +336,11 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
     }
   } else {
     b->lattice = SPH_LATTICE_CELL_CENTRED;
-    TRY(positive(n, "spacing", 1, 0, &b->spacing, err));
+    SPH_TRY(positive(n, "spacing", 1, 0, &b->spacing, err));
   }
   static const char *const dists[] = {"lattice", "jitter", "relax", NULL};
   const char *dist;
-  TRY(sph_node_get_string(n, "distribution", 0, "lattice", &dist, err));
+  SPH_TRY(sph_node_get_string(n, "distribution", 0, "lattice", &dist, err));
   int dk = -1;
   for (int i = 0; dists[i]; ++i)
     if (!strcmp(dist, dists[i]))
@@ -354,20 +352,20 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
                           dist);
   b->distribution = (sph_distribution)dk;
   if (dk != SPH_DIST_LATTICE) {
-    TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
+    SPH_TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
     if (!(b->jitter >= 0.0 && b->jitter < 0.5))
       return sph_node_error(sph_node_child(n, "jitter"), err, SPH_ERR_RANGE,
                             "jitter is a fraction of the spacing in [0, 0.5), "
                             "got %g",
                             b->jitter);
     long seed, steps = 0;
-    TRY(sph_node_get_int(n, "seed", 0, 1, &seed, err));
+    SPH_TRY(sph_node_get_int(n, "seed", 0, 1, &seed, err));
     if (seed < 0)
       return sph_node_error(sph_node_child(n, "seed"), err, SPH_ERR_RANGE,
                             "seed must be >= 0");
     b->seed = (unsigned long)seed;
     if (dk == SPH_DIST_RELAX) {
-      TRY(sph_node_get_int(n, "relax_steps", 0, 100, &steps, err));
+      SPH_TRY(sph_node_get_int(n, "relax_steps", 0, 100, &steps, err));
       if (steps < 0 || steps > 100000)
         return sph_node_error(sph_node_child(n, "relax_steps"), err,
                               SPH_ERR_RANGE,
@@ -397,41 +395,41 @@ static sph_status parse_velocity(sph_scene *s, sph_velocity *v, sph_node *n,
                                       NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
-  TRY(sph_node_check_keys(n, kinds, err));
+  SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
-  TRY(one_of(n, kinds, "initial velocity", &which, err));
+  SPH_TRY(one_of(n, kinds, "initial velocity", &which, err));
   if (which == 0) {
     v->kind = SPH_VEL_UNIFORM;
-    TRY(sph_node_get_doubles(n, "uniform", 1, 3, v->value, NULL, err));
+    SPH_TRY(sph_node_get_doubles(n, "uniform", 1, 3, v->value, NULL, err));
   } else if (which == 1) {
     v->kind = SPH_VEL_ROTATION;
     sph_node *r;
-    TRY(sph_node_get_map(n, "rotation", 1, &r, err));
+    SPH_TRY(sph_node_get_map(n, "rotation", 1, &r, err));
     static const char *const keys[] = {"axis", "omega", "center", "profile",
                                        NULL};
-    TRY(sph_node_check_keys(r, keys, err));
-    TRY(get_axis(r, "axis", 1, 2, &v->axis, err));
-    TRY(sph_node_get_double(r, "omega", 1, 0, &v->omega, err));
+    SPH_TRY(sph_node_check_keys(r, keys, err));
+    SPH_TRY(get_axis(r, "axis", 1, 2, &v->axis, err));
+    SPH_TRY(sph_node_get_double(r, "omega", 1, 0, &v->omega, err));
     if (sph_node_child(r, "center"))
-      TRY(sph_node_get_doubles(r, "center", 1, 3, v->center, NULL, err));
+      SPH_TRY(sph_node_get_doubles(r, "center", 1, 3, v->center, NULL, err));
     else
-      TRY(sph_node_insert_default(r, "center", "[0, 0, 0]", &(sph_node *){0},
-                                  err));
+      SPH_TRY(sph_node_insert_default(r, "center", "[0, 0, 0]",
+                                      &(sph_node *){0}, err));
     sph_node *p = sph_node_child(r, "profile");
     if (p) {
       p->used = 1;
-      TRY(make_expr(p, &v->profile, err));
+      SPH_TRY(make_expr(p, &v->profile, err));
     }
   } else {
     v->kind = SPH_VEL_EXPRESSION;
     sph_node *e;
-    TRY(get_seq(n, "expression", 1, &e, err));
+    SPH_TRY(get_seq(n, "expression", 1, &e, err));
     if (e->count != 3)
       return sph_node_error(e, err, SPH_ERR_TYPE,
                             "expected three expressions (vx, vy, vz), got %zu",
                             e->count);
     for (int c = 0; c < 3; ++c)
-      TRY(make_expr(e->items[c], &v->expr[c], err));
+      SPH_TRY(make_expr(e->items[c], &v->expr[c], err));
   }
   (void)s;
   return SPH_OK;
@@ -439,7 +437,7 @@ static sph_status parse_velocity(sph_scene *s, sph_velocity *v, sph_node *n,
 
 static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
   sph_node *list;
-  TRY(get_seq(root, "bodies", 1, &list, err));
+  SPH_TRY(get_seq(root, "bodies", 1, &list, err));
   if (list->count == 0)
     return sph_node_error(list, err, SPH_ERR_MISSING_KEY,
                           "define at least one body");
@@ -455,17 +453,17 @@ static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
     if (n->kind != SPH_NODE_MAP)
       return sph_node_error(n, err, SPH_ERR_TYPE,
                             "expected a body (a mapping)");
-    TRY(sph_node_check_keys(n, keys, err));
+    SPH_TRY(sph_node_check_keys(n, keys, err));
     b->line = n->line;
     b->col = n->col;
     const char *name, *mat;
-    TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
     copy_name(b->name, name);
     for (size_t j = 0; j < i; ++j)
       if (!strcmp(s->bodies[j].name, name))
         return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_ARG,
                               "two bodies are named '%s'", name);
-    TRY(sph_node_get_string(n, "material", 1, NULL, &mat, err));
+    SPH_TRY(sph_node_get_string(n, "material", 1, NULL, &mat, err));
     b->material = sph_scene_find_material(s, mat);
     if (b->material < 0) {
       const char *names[64];
@@ -480,13 +478,13 @@ static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
                             hint ? "'?" : "");
     }
     sph_node *shape, *parts, *vel;
-    TRY(sph_node_get_map(n, "shape", 1, &shape, err));
-    TRY(parse_shape(s, &b->shape, shape, err));
-    TRY(sph_node_get_map(n, "particles", 1, &parts, err));
-    TRY(parse_particles(s, b, parts, err));
-    TRY(sph_node_get_map(n, "initial_velocity", 0, &vel, err));
+    SPH_TRY(sph_node_get_map(n, "shape", 1, &shape, err));
+    SPH_TRY(parse_shape(s, &b->shape, shape, err));
+    SPH_TRY(sph_node_get_map(n, "particles", 1, &parts, err));
+    SPH_TRY(parse_particles(s, b, parts, err));
+    SPH_TRY(sph_node_get_map(n, "initial_velocity", 0, &vel, err));
     if (vel)
-      TRY(parse_velocity(s, &b->velocity, vel, err));
+      SPH_TRY(parse_velocity(s, &b->velocity, vel, err));
   }
   return SPH_OK;
 }
@@ -494,20 +492,20 @@ static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
 static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
                                   sph_error *err) {
   static const char *const kinds[] = {"plane", "box", "face", NULL};
-  TRY(sph_node_check_keys(n, kinds, err));
+  SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
-  TRY(one_of(n, kinds, "selection", &which, err));
+  SPH_TRY(one_of(n, kinds, "selection", &which, err));
   sph_node *g;
-  TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
+  SPH_TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
   sel->body = -1;
   sel->kind = (sph_select_kind)which;
   const char *body = NULL;
   if (which == SPH_SELECT_FACE) {
     static const char *const keys[] = {"body", "side", NULL};
-    TRY(sph_node_check_keys(g, keys, err));
-    TRY(sph_node_get_string(g, "body", 1, NULL, &body, err));
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(sph_node_get_string(g, "body", 1, NULL, &body, err));
     const char *side;
-    TRY(sph_node_get_string(g, "side", 1, NULL, &side, err));
+    SPH_TRY(sph_node_get_string(g, "side", 1, NULL, &side, err));
     int ok = strlen(side) == 2 && (side[1] == '-' || side[1] == '+');
     int a = ok ? side[0] - 'x' : -1;
     if (a < 0 || a > s->dimension - 1)
@@ -520,18 +518,20 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
     static const char *const pkeys[] = {"axis", "at", "tolerance", "body",
                                         NULL};
     static const char *const bkeys[] = {"min", "max", "body", NULL};
-    TRY(sph_node_check_keys(g, which == 0 ? pkeys : bkeys, err));
-    TRY(sph_node_get_string(g, "body", 0, NULL, &body, err));
+    SPH_TRY(sph_node_check_keys(g, which == 0 ? pkeys : bkeys, err));
+    SPH_TRY(sph_node_get_string(g, "body", 0, NULL, &body, err));
     if (which == SPH_SELECT_PLANE) {
-      TRY(get_axis(g, "axis", 1, 0, &sel->axis, err));
-      TRY(sph_node_get_double(g, "at", 1, 0, &sel->at, err));
+      SPH_TRY(get_axis(g, "axis", 1, 0, &sel->axis, err));
+      SPH_TRY(sph_node_get_double(g, "at", 1, 0, &sel->at, err));
       sel->tolerance = -1.0; /* resolved below */
       if (sph_node_child(g, "tolerance"))
-        TRY(positive(g, "tolerance", 1, 0, &sel->tolerance, err));
+        SPH_TRY(positive(g, "tolerance", 1, 0, &sel->tolerance, err));
     } else {
       int d = s->dimension;
-      TRY(sph_node_get_doubles(g, "min", 1, (size_t)d, sel->min, NULL, err));
-      TRY(sph_node_get_doubles(g, "max", 1, (size_t)d, sel->max, NULL, err));
+      SPH_TRY(
+          sph_node_get_doubles(g, "min", 1, (size_t)d, sel->min, NULL, err));
+      SPH_TRY(
+          sph_node_get_doubles(g, "max", 1, (size_t)d, sel->max, NULL, err));
       for (int c = 0; c < d; ++c)
         if (sel->max[c] < sel->min[c])
           return sph_node_error(sph_node_child(g, "max"), err, SPH_ERR_GEOMETRY,
@@ -551,7 +551,8 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
     char buf[40];
     snprintf(buf, sizeof buf, "%.6g", 0.5 * spacing);
     sel->tolerance = strtod(buf, NULL);
-    TRY(sph_node_insert_default(g, "tolerance", buf, &(sph_node *){0}, err));
+    SPH_TRY(
+        sph_node_insert_default(g, "tolerance", buf, &(sph_node *){0}, err));
   } else if (sel->kind != SPH_SELECT_PLANE) {
     sel->tolerance = 1e-9 * spacing;
   }
@@ -561,7 +562,7 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
 static sph_status parse_boundaries(sph_scene *s, sph_node *root,
                                    sph_error *err) {
   sph_node *list;
-  TRY(get_seq(root, "boundaries", 0, &list, err));
+  SPH_TRY(get_seq(root, "boundaries", 0, &list, err));
   if (!list)
     return SPH_OK;
   s->boundaries = calloc(list->count ? list->count : 1, sizeof *s->boundaries);
@@ -579,17 +580,17 @@ static sph_status parse_boundaries(sph_scene *s, sph_node *root,
     if (n->kind != SPH_NODE_MAP)
       return sph_node_error(n, err, SPH_ERR_TYPE,
                             "expected a boundary condition (a mapping)");
-    TRY(sph_node_check_keys(n, keys, err));
+    SPH_TRY(sph_node_check_keys(n, keys, err));
     b->line = n->line;
     b->col = n->col;
     const char *name;
-    TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
     copy_name(b->name, name);
     sph_node *sel;
-    TRY(sph_node_get_map(n, "select", 1, &sel, err));
-    TRY(parse_selection(s, &b->select, sel, err));
+    SPH_TRY(sph_node_get_map(n, "select", 1, &sel, err));
+    SPH_TRY(parse_selection(s, &b->select, sel, err));
     int which;
-    TRY(one_of(n, conds, "condition", &which, err));
+    SPH_TRY(one_of(n, conds, "condition", &which, err));
     static const sph_condition_kind kinds[] = {SPH_BC_CLAMP, SPH_BC_ROLLER,
                                                SPH_BC_VELOCITY, SPH_BC_SYMMETRY,
                                                SPH_BC_SKEW_SYMMETRY};
@@ -598,28 +599,28 @@ static sph_status parse_boundaries(sph_scene *s, sph_node *root,
     b->until = INFINITY;
     if (b->kind == SPH_BC_CLAMP) {
       int on;
-      TRY(sph_node_get_bool(n, "clamp", 1, 1, &on, err));
+      SPH_TRY(sph_node_get_bool(n, "clamp", 1, 1, &on, err));
       if (!on)
         return sph_node_error(sph_node_child(n, "clamp"), err, SPH_ERR_RANGE,
                               "clamp: false imposes nothing; remove the "
                               "boundary instead");
     } else if (b->kind == SPH_BC_VELOCITY) {
       sph_node *v;
-      TRY(sph_node_get_map(n, "velocity", 1, &v, err));
+      SPH_TRY(sph_node_get_map(n, "velocity", 1, &v, err));
       static const char *const vkeys[] = {"value", "from", "until",
                                           "components", NULL};
-      TRY(sph_node_check_keys(v, vkeys, err));
-      TRY(sph_node_get_doubles(v, "value", 1, 3, b->value, NULL, err));
-      TRY(sph_node_get_double(v, "from", 0, 0.0, &b->from, err));
+      SPH_TRY(sph_node_check_keys(v, vkeys, err));
+      SPH_TRY(sph_node_get_doubles(v, "value", 1, 3, b->value, NULL, err));
+      SPH_TRY(sph_node_get_double(v, "from", 0, 0.0, &b->from, err));
       if (sph_node_child(v, "until")) {
-        TRY(sph_node_get_double(v, "until", 1, 0, &b->until, err));
+        SPH_TRY(sph_node_get_double(v, "until", 1, 0, &b->until, err));
         if (!(b->until > b->from))
           return sph_node_error(sph_node_child(v, "until"), err, SPH_ERR_RANGE,
                                 "until (%g) must be after from (%g)", b->until,
                                 b->from);
       }
       sph_node *comp;
-      TRY(get_seq(v, "components", 0, &comp, err));
+      SPH_TRY(get_seq(v, "components", 0, &comp, err));
       if (comp) {
         b->mask = 0;
         for (size_t k = 0; k < comp->count; ++k) {
@@ -633,10 +634,10 @@ static sph_status parse_boundaries(sph_scene *s, sph_node *root,
       }
     } else {
       sph_node *c;
-      TRY(sph_node_get_map(n, conds[which], 1, &c, err));
+      SPH_TRY(sph_node_get_map(n, conds[which], 1, &c, err));
       static const char *const akeys[] = {"axis", NULL};
-      TRY(sph_node_check_keys(c, akeys, err));
-      TRY(get_axis(c, "axis", 1, 0, &b->axis, err));
+      SPH_TRY(sph_node_check_keys(c, akeys, err));
+      SPH_TRY(get_axis(c, "axis", 1, 0, &b->axis, err));
       if (b->kind != SPH_BC_ROLLER) {
         if (b->select.kind != SPH_SELECT_PLANE || b->select.axis != b->axis)
           return sph_node_error(sph_node_child(n, conds[which]), err,
@@ -691,17 +692,17 @@ static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
 
 static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   sph_node *png;
-  TRY(sph_node_get_map(out, "png", 0, &png, err));
+  SPH_TRY(sph_node_get_map(out, "png", 0, &png, err));
   sph_png_output *p = &s->output.png;
   if (!png)
     return SPH_OK;
   static const char *const keys[] = {"width", "height", "color",
                                      "range", "camera", NULL};
-  TRY(sph_node_check_keys(png, keys, err));
+  SPH_TRY(sph_node_check_keys(png, keys, err));
   p->enabled = 1;
   long w, h;
-  TRY(sph_node_get_int(png, "width", 0, 1280, &w, err));
-  TRY(sph_node_get_int(png, "height", 0, 720, &h, err));
+  SPH_TRY(sph_node_get_int(png, "width", 0, 1280, &w, err));
+  SPH_TRY(sph_node_get_int(png, "height", 0, 720, &h, err));
   if (w < 16 || w > 16384)
     return sph_node_error(sph_node_child(png, "width"), err, SPH_ERR_RANGE,
                           "width must be in [16, 16384], got %ld", w);
@@ -711,7 +712,7 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   p->width = (int)w;
   p->height = (int)h;
   const char *color;
-  TRY(sph_node_get_string(png, "color", 0, "pressure", &color, err));
+  SPH_TRY(sph_node_get_string(png, "color", 0, "pressure", &color, err));
   int f = sph_field_from_name(color);
   if (f < 0)
     return sph_node_error(sph_node_child(png, "color"), err, SPH_ERR_RANGE,
@@ -721,14 +722,14 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   snprintf(p->range_mode, sizeof p->range_mode, "symmetric");
   if (range && range->kind == SPH_NODE_SEQ) {
     range->used = 1;
-    TRY(sph_node_get_doubles(png, "range", 1, 2, p->range, NULL, err));
+    SPH_TRY(sph_node_get_doubles(png, "range", 1, 2, p->range, NULL, err));
     if (!(p->range[1] > p->range[0]))
       return sph_node_error(range, err, SPH_ERR_RANGE,
                             "range [min, max] needs min < max");
     snprintf(p->range_mode, sizeof p->range_mode, "fixed");
   } else {
     const char *mode;
-    TRY(sph_node_get_string(png, "range", 0, "symmetric", &mode, err));
+    SPH_TRY(sph_node_get_string(png, "range", 0, "symmetric", &mode, err));
     if (strcmp(mode, "auto") && strcmp(mode, "symmetric") &&
         strcmp(mode, "global"))
       return sph_node_error(sph_node_child(png, "range"), err, SPH_ERR_RANGE,
@@ -738,29 +739,31 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
     snprintf(p->range_mode, sizeof p->range_mode, "%s", mode);
   }
   sph_node *cam;
-  TRY(sph_node_get_map(png, "camera", 0, &cam, err));
+  SPH_TRY(sph_node_get_map(png, "camera", 0, &cam, err));
   if (cam) {
     static const char *const ckeys[] = {"position",   "target",    "up",
                                         "azimuth",    "elevation", "zoom",
                                         "projection", NULL};
-    TRY(sph_node_check_keys(cam, ckeys, err));
+    SPH_TRY(sph_node_check_keys(cam, ckeys, err));
     sph_camera *c = &p->camera;
     c->given = 1;
     c->up[1] = 1.0;
     c->zoom = 1.0;
     if (sph_node_child(cam, "position")) {
       c->has_position = 1;
-      TRY(sph_node_get_doubles(cam, "position", 1, 3, c->position, NULL, err));
+      SPH_TRY(
+          sph_node_get_doubles(cam, "position", 1, 3, c->position, NULL, err));
     }
     if (sph_node_child(cam, "target"))
-      TRY(sph_node_get_doubles(cam, "target", 1, 3, c->target, NULL, err));
+      SPH_TRY(sph_node_get_doubles(cam, "target", 1, 3, c->target, NULL, err));
     if (sph_node_child(cam, "up"))
-      TRY(sph_node_get_doubles(cam, "up", 1, 3, c->up, NULL, err));
-    TRY(sph_node_get_double(cam, "azimuth", 0, 0.0, &c->azimuth, err));
-    TRY(sph_node_get_double(cam, "elevation", 0, 0.0, &c->elevation, err));
-    TRY(positive(cam, "zoom", 0, 1.0, &c->zoom, err));
+      SPH_TRY(sph_node_get_doubles(cam, "up", 1, 3, c->up, NULL, err));
+    SPH_TRY(sph_node_get_double(cam, "azimuth", 0, 0.0, &c->azimuth, err));
+    SPH_TRY(sph_node_get_double(cam, "elevation", 0, 0.0, &c->elevation, err));
+    SPH_TRY(positive(cam, "zoom", 0, 1.0, &c->zoom, err));
     const char *proj;
-    TRY(sph_node_get_string(cam, "projection", 0, "orthographic", &proj, err));
+    SPH_TRY(
+        sph_node_get_string(cam, "projection", 0, "orthographic", &proj, err));
     if (strcmp(proj, "orthographic") && strcmp(proj, "perspective"))
       return sph_node_error(sph_node_child(cam, "projection"), err,
                             SPH_ERR_RANGE,
@@ -772,47 +775,48 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
 
 static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
   sph_node *out;
-  TRY(sph_node_insert_default(root, "output", "{}", &out, err));
+  SPH_TRY(sph_node_insert_default(root, "output", "{}", &out, err));
   if (out->kind != SPH_NODE_MAP)
     return sph_node_error(out, err, SPH_ERR_TYPE, "expected a mapping");
   static const char *const keys[] = {"every",  "fields",           "vtk", "png",
                                      "probes", "checkpoint_every", NULL};
-  TRY(sph_node_check_keys(out, keys, err));
+  SPH_TRY(sph_node_check_keys(out, keys, err));
   sph_output *o = &s->output;
-  TRY(positive(out, "every", 0, s->t_end / 100.0, &o->every, err));
+  SPH_TRY(positive(out, "every", 0, s->t_end / 100.0, &o->every, err));
   if (o->every > s->t_end * (1 + 1e-12))
     return sph_node_error(sph_node_child(out, "every"), err, SPH_ERR_RANGE,
                           "output interval %g is longer than the run (%g)",
                           o->every, s->t_end);
   sph_node *fields;
-  TRY(sph_node_insert_default(
+  SPH_TRY(sph_node_insert_default(
       out, "fields",
       "[pressure, velocity, displacement, von_mises, J, body_id]", &fields,
       err));
   if (fields->kind != SPH_NODE_SEQ)
     return sph_node_error(fields, err, SPH_ERR_TYPE,
                           "expected a list of field names");
-  TRY(field_list(s, fields, o->fields, &o->nfields, SPH_FIELD_COUNT, 1, err));
+  SPH_TRY(
+      field_list(s, fields, o->fields, &o->nfields, SPH_FIELD_COUNT, 1, err));
   sph_node *vtk = sph_node_child(out, "vtk");
   o->vtk = 1;
   if (vtk && vtk->kind == SPH_NODE_MAP) {
     vtk->used = 1;
     static const char *const vkeys[] = {"format", NULL};
-    TRY(sph_node_check_keys(vtk, vkeys, err));
+    SPH_TRY(sph_node_check_keys(vtk, vkeys, err));
     const char *fmt;
-    TRY(sph_node_get_string(vtk, "format", 0, "binary", &fmt, err));
+    SPH_TRY(sph_node_get_string(vtk, "format", 0, "binary", &fmt, err));
     if (strcmp(fmt, "binary") && strcmp(fmt, "ascii"))
       return sph_node_error(sph_node_child(vtk, "format"), err, SPH_ERR_RANGE,
                             "format is binary or ascii, got '%s'", fmt);
     o->vtk_ascii = !strcmp(fmt, "ascii");
   } else {
-    TRY(sph_node_get_bool(out, "vtk", 0, 1, &o->vtk, err));
+    SPH_TRY(sph_node_get_bool(out, "vtk", 0, 1, &o->vtk, err));
   }
-  TRY(parse_png(s, out, err));
+  SPH_TRY(parse_png(s, out, err));
   if (sph_node_child(out, "checkpoint_every"))
-    TRY(positive(out, "checkpoint_every", 1, 0, &o->checkpoint_every, err));
+    SPH_TRY(positive(out, "checkpoint_every", 1, 0, &o->checkpoint_every, err));
   sph_node *probes;
-  TRY(get_seq(out, "probes", 0, &probes, err));
+  SPH_TRY(get_seq(out, "probes", 0, &probes, err));
   if (probes && probes->count) {
     o->probes = calloc(probes->count, sizeof *o->probes);
     if (!o->probes)
@@ -825,22 +829,22 @@ static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
       if (n->kind != SPH_NODE_MAP)
         return sph_node_error(n, err, SPH_ERR_TYPE,
                               "expected a probe (a mapping)");
-      TRY(sph_node_check_keys(n, pkeys, err));
+      SPH_TRY(sph_node_check_keys(n, pkeys, err));
       const char *name;
-      TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+      SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
       copy_name(p->name, name);
-      TRY(sph_node_get_doubles(n, "at", 1, (size_t)s->dimension, p->at, NULL,
-                               err));
+      SPH_TRY(sph_node_get_doubles(n, "at", 1, (size_t)s->dimension, p->at,
+                                   NULL, err));
       sph_node *at = sph_node_child(n, "at");
       p->line = at->line;
       p->col = at->col;
       sph_node *pf;
-      TRY(sph_node_insert_default(n, "fields", "[displacement, velocity]", &pf,
-                                  err));
+      SPH_TRY(sph_node_insert_default(n, "fields", "[displacement, velocity]",
+                                      &pf, err));
       if (pf->kind != SPH_NODE_SEQ)
         return sph_node_error(pf, err, SPH_ERR_TYPE,
                               "expected a list of field names");
-      TRY(field_list(s, pf, p->fields, &p->nfields, 8, 0, err));
+      SPH_TRY(field_list(s, pf, p->fields, &p->nfields, 8, 0, err));
     }
   }
   return SPH_OK;
@@ -854,9 +858,9 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   static const char *const keys[] = {
       "name",       "dimension",  "method", "kernel", "materials", "bodies",
       "boundaries", "body_force", "time",   "output", "reference", NULL};
-  TRY(sph_node_check_keys(root, keys, err));
+  SPH_TRY(sph_node_check_keys(root, keys, err));
   const char *name;
-  TRY(sph_node_get_string(root, "name", 1, NULL, &name, err));
+  SPH_TRY(sph_node_get_string(root, "name", 1, NULL, &name, err));
   size_t len = strlen(name);
   int ok = len > 0 && len < SPH_NAME_MAX;
   for (const char *c = name; *c && ok; ++c)
@@ -868,31 +872,31 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
                           name);
   copy_name(s->name, name);
   long dim;
-  TRY(sph_node_get_int(root, "dimension", 1, 3, &dim, err));
+  SPH_TRY(sph_node_get_int(root, "dimension", 1, 3, &dim, err));
   if (dim != 2 && dim != 3)
     return sph_node_error(sph_node_child(root, "dimension"), err, SPH_ERR_RANGE,
                           "dimension is 2 or 3, got %ld", dim);
   s->dimension = (int)dim;
-  TRY(sph_node_get_map(root, "method", 1, &s->method, err));
+  SPH_TRY(sph_node_get_map(root, "method", 1, &s->method, err));
   const char *method;
-  TRY(sph_node_get_string(s->method, "name", 1, NULL, &method, err));
+  SPH_TRY(sph_node_get_string(s->method, "name", 1, NULL, &method, err));
   copy_name(s->method_name, method);
-  TRY(sph_node_get_map(root, "reference", 0, &s->reference, err));
+  SPH_TRY(sph_node_get_map(root, "reference", 0, &s->reference, err));
   sph_node *time;
-  TRY(sph_node_get_map(root, "time", 1, &time, err));
+  SPH_TRY(sph_node_get_map(root, "time", 1, &time, err));
   static const char *const tkeys[] = {"end", NULL};
-  TRY(sph_node_check_keys(time, tkeys, err));
-  TRY(positive(time, "end", 1, 0, &s->t_end, err));
-  TRY(parse_kernel(s, root, err));
-  TRY(parse_materials(s, root, err));
-  TRY(parse_bodies(s, root, err));
-  TRY(parse_boundaries(s, root, err));
+  SPH_TRY(sph_node_check_keys(time, tkeys, err));
+  SPH_TRY(positive(time, "end", 1, 0, &s->t_end, err));
+  SPH_TRY(parse_kernel(s, root, err));
+  SPH_TRY(parse_materials(s, root, err));
+  SPH_TRY(parse_bodies(s, root, err));
+  SPH_TRY(parse_boundaries(s, root, err));
   if (sph_node_child(root, "body_force")) {
     s->has_body_force = 1;
-    TRY(sph_node_get_doubles(root, "body_force", 1, 3, s->body_force, NULL,
-                             err));
+    SPH_TRY(sph_node_get_doubles(root, "body_force", 1, 3, s->body_force, NULL,
+                                 err));
   }
-  TRY(parse_output(s, root, err));
+  SPH_TRY(parse_output(s, root, err));
   return SPH_OK;
 }
 
@@ -1015,7 +1019,7 @@ static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
   if (s->nbodies < 2)
     return SPH_OK;
   sph_neighbors *nl;
-  TRY(sph_neighbors_create(&nl, err));
+  SPH_TRY(sph_neighbors_create(&nl, err));
   sph_status st = sph_neighbors_build(
       nl, ps->field[SPH_FIELD_POSITION0], ps->n, s->dimension,
       0.5 * sph_scene_min_spacing(s), NULL, SPH_PAIRS_ALL, err);

@@ -16,13 +16,6 @@
 #include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
-#define TRY(expr)                                                              \
-  do {                                                                         \
-    sph_status st_ = (expr);                                                   \
-    if (st_ != SPH_OK)                                                         \
-      return st_;                                                              \
-  } while (0)
-
 /* ---- stress and state
  * ---------------------------------------------------------- */
 
@@ -133,7 +126,7 @@ static double tl_jst_stable_dt(sph_sim *sim) {
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
-  TRY(sph_tvd_rk2_step(&m->ode, sim->t, dt, err));
+  SPH_TRY(sph_tvd_rk2_step(&m->ode, sim->t, dt, err));
   long n3 = 3 * (long)sim->ps->n;
   for (long i = 0; i < n3; ++i)
     if (!isfinite(m->p[i]) || !isfinite(m->x[i]))
@@ -228,7 +221,7 @@ static sph_status parse_choice(sph_node *opt, const char *key,
                                const char *const *values, const char *def,
                                int *out, sph_error *err) {
   const char *v;
-  TRY(sph_node_get_string(opt, key, 0, def, &v, err));
+  SPH_TRY(sph_node_get_string(opt, key, 0, def, &v, err));
   char list[128] = "";
   for (int i = 0; values[i]; ++i) {
     if (!strcmp(values[i], v)) {
@@ -290,7 +283,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                                      "cfl",
                                      "essential_bc",
                                      NULL};
-  TRY(sph_node_check_keys(opt, keys, err));
+  SPH_TRY(sph_node_check_keys(opt, keys, err));
   tl_jst *m = calloc(1, sizeof *m);
   if (!m)
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-jst");
@@ -307,32 +300,33 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   static const char *const integrators[] = {"tvd-rk2", NULL};
   static const char *const bcs[] = {"direct", NULL};
   int f, fo, lp, integ, bc, amp, jproj;
-  TRY(parse_choice(opt, "fields", fields, "pF", &f, err));
-  TRY(parse_choice(opt, "force", forces, "conservative", &fo, err));
-  TRY(parse_choice(opt, "laplacian", laps, "corrected", &lp, err));
-  TRY(parse_choice(opt, "integrator", integrators, "tvd-rk2", &integ, err));
-  TRY(parse_choice(opt, "essential_bc", bcs, "direct", &bc, err));
+  SPH_TRY(parse_choice(opt, "fields", fields, "pF", &f, err));
+  SPH_TRY(parse_choice(opt, "force", forces, "conservative", &fo, err));
+  SPH_TRY(parse_choice(opt, "laplacian", laps, "corrected", &lp, err));
+  SPH_TRY(parse_choice(opt, "integrator", integrators, "tvd-rk2", &integ, err));
+  SPH_TRY(parse_choice(opt, "essential_bc", bcs, "direct", &bc, err));
   m->fields = (tl_jst_fields)f;
   m->force = (tl_jst_force)fo;
-  TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
   if (!(m->cfl > 0.0 && m->cfl <= 1.5))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
                           "cfl must be in (0, 1.5], got %g", m->cfl);
-  TRY(sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &amp, err));
-  TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &jproj, err));
+  SPH_TRY(
+      sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &amp, err));
+  SPH_TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &jproj, err));
   sph_node *jst;
-  TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
+  SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
   if (jst->kind != SPH_NODE_MAP)
     return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
   static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
                                       NULL};
-  TRY(sph_node_check_keys(jst, jkeys, err));
+  SPH_TRY(sph_node_check_keys(jst, jkeys, err));
   double e2p, e4p, e2j = 0.0, e4j = 0.0;
-  TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
-  TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
   if (m->fields != TL_JST_PF) {
-    TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
-    TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
+    SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
+    SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
   } else if (sph_node_child(jst, "eps2_J") || sph_node_child(jst, "eps4_J")) {
     sph_node *bad = sph_node_child(jst, "eps2_J")
                         ? sph_node_child(jst, "eps2_J")
@@ -359,8 +353,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 
   /* per-particle material, density, wave speed */
   m->mat = malloc((n ? n : 1) * sizeof *m->mat);
-  TRY(m->mat ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "materials"));
-  TRY(alloc_zero(&m->rho0, n, err));
+  SPH_TRY(m->mat ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "materials"));
+  SPH_TRY(alloc_zero(&m->rho0, n, err));
   for (size_t a = 0; a < n; ++a) {
     m->mat[a] = &s->materials[s->bodies[ps->body[a]].material];
     m->rho0[a] = m->mat[a]->density;
@@ -377,9 +371,9 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                       SPH_FIELD_STRESS,    SPH_FIELD_PRESSURE,
                       SPH_FIELD_VON_MISES, SPH_FIELD_MASS};
   for (size_t i = 0; i < sizeof need / sizeof *need; ++i)
-    TRY(sph_particles_require(ps, need[i], err));
+    SPH_TRY(sph_particles_require(ps, need[i], err));
   if (m->fields == TL_JST_PFHJ)
-    TRY(sph_particles_require(ps, SPH_FIELD_COFACTOR, err));
+    SPH_TRY(sph_particles_require(ps, SPH_FIELD_COFACTOR, err));
   m->x = ps->field[SPH_FIELD_POSITION];
   m->p = ps->field[SPH_FIELD_MOMENTUM];
   m->F = ps->field[SPH_FIELD_DEFGRAD];
@@ -401,11 +395,11 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   /* neighbours and corrections in the reference configuration */
   int timer = sph_sim_add_timer(sim, "corrections");
   double t0 = sph_wtime();
-  TRY(sph_neighbors_create(&m->nl, err));
-  TRY(sph_neighbors_build(m->nl, ps->field[SPH_FIELD_POSITION0], n,
-                          s->dimension, sim->kernel.support, ps->body,
-                          SPH_PAIRS_SAME_BODY, err));
-  TRY(reverse_slots(m, err));
+  SPH_TRY(sph_neighbors_create(&m->nl, err));
+  SPH_TRY(sph_neighbors_build(m->nl, ps->field[SPH_FIELD_POSITION0], n,
+                              s->dimension, sim->kernel.support, ps->body,
+                              SPH_PAIRS_SAME_BODY, err));
+  SPH_TRY(reverse_slots(m, err));
   sph_cloud cloud = {.n = n,
                      .dim = s->dimension,
                      .x = ps->field[SPH_FIELD_POSITION0],
@@ -413,14 +407,14 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .id = ps->id,
                      .nl = m->nl,
                      .kernel = &sim->kernel};
-  TRY(alloc_zero(&m->grad, 3 * m->nl->count, err));
-  TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, m->grad, NULL, NULL,
-                              err));
+  SPH_TRY(alloc_zero(&m->grad, 3 * m->nl->count, err));
+  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, m->grad, NULL,
+                                  NULL, err));
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
-    TRY(alloc_zero(&m->lap, m->nl->count, err));
+    SPH_TRY(alloc_zero(&m->lap, m->nl->count, err));
     if (lp == 0) {
-      TRY(sph_correction_laplacian(&cloud, m->lap, err));
+      SPH_TRY(sph_correction_laplacian(&cloud, m->lap, err));
     } else {
       /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
       const double *X = ps->field[SPH_FIELD_POSITION0];
@@ -450,36 +444,36 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   for (int i = 0; i < 5; ++i) {
     if (!use[i])
       continue;
-    TRY(alloc_zero(y0[i], len[i], err));
-    TRY(alloc_zero(r[i], len[i], err));
+    SPH_TRY(alloc_zero(y0[i], len[i], err));
+    SPH_TRY(alloc_zero(r[i], len[i], err));
     ode->y[ode->nvec] = *y[i];
     ode->y0[ode->nvec] = *y0[i];
     ode->rate[ode->nvec] = *r[i];
     ode->len[ode->nvec] = len[i];
     ode->nvec++;
   }
-  TRY(alloc_zero(&m->xmoment, 3 * n, err));
+  SPH_TRY(alloc_zero(&m->xmoment, 3 * n, err));
   ode->rhs = tl_jst_rhs;
   ode->constrain = tl_jst_constrain;
   ode->ctx = m;
 
   /* terms, only those asked for, in the order of Algorithm 1 */
   if (amp)
-    TRY(angular_momentum_projection_create(sim, err));
+    SPH_TRY(angular_momentum_projection_create(sim, err));
   if (need_p) {
     jst_params jp = {m->nl, m->lap, 3, e2p, e4p, m->cp, sim->dp, jproj};
-    TRY(jst_dissipation_create(sim, &jp, err));
+    SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (need_j) {
     jst_params jp = {m->nl, m->lap, 1, e2j, e4j, m->cp, sim->dp, jproj};
-    TRY(jst_dissipation_create(sim, &jp, err));
+    SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (s->has_body_force)
-    TRY(body_force_create(sim, m->rho0, err));
+    SPH_TRY(body_force_create(sim, m->rho0, err));
   if (s->nboundaries) {
-    TRY(essential_bc_create(sim, m->rho0, err));
+    SPH_TRY(essential_bc_create(sim, m->rho0, err));
     /* the initial state honours the constraints */
-    TRY(tl_jst_constrain(m, 0.0, err));
+    SPH_TRY(tl_jst_constrain(m, 0.0, err));
   }
   (void)integ;
   (void)bc;
