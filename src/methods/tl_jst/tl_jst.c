@@ -321,20 +321,16 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
                                       NULL};
   SPH_TRY(sph_node_check_keys(jst, jkeys, err));
-  double e2p, e4p, e2j = 0.0, e4j = 0.0;
+  double e2p, e4p, e2j, e4j;
   SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
   SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
-  if (m->fields != TL_JST_PF) {
-    SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
-    SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
-  } else if (sph_node_child(jst, "eps2_J") || sph_node_child(jst, "eps4_J")) {
-    sph_node *bad = sph_node_child(jst, "eps2_J")
-                        ? sph_node_child(jst, "eps2_J")
-                        : sph_node_child(jst, "eps4_J");
-    return sph_node_error(bad, err, SPH_ERR_ARG,
+  SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
+  if (m->fields == TL_JST_PF && (e2j != 0.0 || e4j != 0.0))
+    return sph_node_error(sph_node_child(jst, e2j != 0.0 ? "eps2_J" : "eps4_J"),
+                          err, SPH_ERR_ARG,
                           "fields pF has no J equation; use fields pFJ or "
-                          "pFHJ for JST on J");
-  }
+                          "pFHJ for JST on J, or set it to 0");
   double eps[4] = {e2p, e4p, e2j, e4j};
   for (int i = 0; i < 4; ++i)
     if (eps[i] < 0.0)

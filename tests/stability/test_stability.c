@@ -1,0 +1,136 @@
+/* Hard cases at CI size (BENCHMARKS.md A2, A4, A5): each run's verdict and
+ * the indicator for its failure mode, measured through the same verdict the
+ * sph command uses, plus a deliberately unstable configuration (no JST)
+ * that the energy indicator must flag. */
+#include "test_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sph/scene.h"
+#include "sph/sim.h"
+#include "sph/stability.h"
+
+typedef struct outcome {
+  int stable;
+  char reason[256];
+  double t, cb_mean, cb_max, j_min, e0, e1;
+} outcome;
+
+/* runs scenes/<name>.yaml with overrides, observing every `every` s */
+static outcome run(const char *name, const char *const *sets, size_t nsets,
+                   double every) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/scenes/%s.yaml", SPH_SOURCE_DIR, name);
+  sph_scene *s;
+  sph_sim *sim;
+  sph_verdict *v;
+  sph_error err;
+  ck_assert_msg(sph_scene_load(&s, path, sets, nsets, &err) == SPH_OK, "%s",
+                err.message);
+  ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
+  ck_assert(sph_verdict_create(&v, sim, &err) == SPH_OK);
+  outcome o = {0};
+  double sum = 0.0;
+  int frames = 0;
+  for (int k = 0; v->stable; ++k) {
+    double next = fmin(s->t_end, every * k);
+    while (sim->t < next - 1e-12 * s->t_end) {
+      if (sph_sim_step(sim, next - sim->t, &err) != SPH_OK) {
+        sph_verdict_fail(v, sim->t, err.message);
+        break;
+      }
+    }
+    if (!v->stable)
+      break;
+    ck_assert(sim->method->derive(sim, &err) == SPH_OK);
+    sph_frame fr = {.time = sim->t, .sim = sim, .ps = sim->ps};
+    sim->method->energy(sim, &fr.kinetic, &fr.strain);
+    sph_verdict_observe(v, &fr);
+    if (frames++ > 0) /* the state at rest has no pressure to judge */
+      sum += v->checkerboard;
+    if (next >= s->t_end)
+      break;
+  }
+  o.stable = v->stable;
+  snprintf(o.reason, sizeof o.reason, "%s", v->reason);
+  o.t = sim->t;
+  o.cb_mean = frames > 1 ? sum / (frames - 1) : 0.0;
+  o.cb_max = v->checkerboard_max;
+  o.j_min = v->J_min;
+  o.e0 = v->energy0;
+  o.e1 = v->energy_final;
+  printf("%-32s %s t = %.4g  checkerboard mean %.3f max %.3f  J min %.3f  "
+         "energy %.4g -> %.4g %s\n",
+         name, o.stable ? "stable  " : "UNSTABLE", o.t, o.cb_mean, o.cb_max,
+         o.j_min, o.e0, o.e1, o.reason);
+  sph_verdict_destroy(v);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+  return o;
+}
+
+START_TEST(twisting_column_nearly_incompressible) {
+  /* A2 at nu = 0.499, 5 x 25 x 5, to 0.25 s. Seed 000 Fig. 28 shows {p,F}
+   * breaking down; an independent implementation (BENCHMARKS D.3) and this
+   * one find {p,F} noisier but not divergent at this size, so the test
+   * asserts what is measured: both stable, {p,F,J} smoother. */
+  const char *pf[] = {"method.fields=pF", "method.jst.eps4_J=0",
+                      "time.end=0.25"};
+  const char *pfj[] = {"time.end=0.25"};
+  outcome a = run("twisting_column_incompressible", pf, 3, 0.005);
+  outcome b = run("twisting_column_incompressible", pfj, 1, 0.005);
+  ck_assert_msg(b.stable, "pFJ: %s", b.reason);
+  ck_assert(b.t >= 0.25 - 1e-12);
+  ck_assert_msg(a.stable, "pF: %s", a.reason);
+  ck_assert_msg(b.cb_mean < a.cb_mean, "pFJ (%g) not smoother than pF (%g)",
+                b.cb_mean, a.cb_mean);
+}
+END_TEST
+
+START_TEST(punch_nearly_incompressible) {
+  /* A4, nu = 0.499: {p,F,J} and {p,F,H,J} reach the full punch travel */
+  const char *pfj[] = {"method.fields=pFJ"};
+  const char *pfhj[] = {"method.fields=pFHJ"};
+  outcome a = run("punch", pfj, 1, 0.001);
+  outcome b = run("punch", pfhj, 1, 0.001);
+  ck_assert_msg(a.stable && a.t >= 0.014 - 1e-12, "pFJ: %s", a.reason);
+  ck_assert_msg(b.stable && b.t >= 0.014 - 1e-12, "pFHJ: %s", b.reason);
+  ck_assert(a.j_min > 0.0 && b.j_min > 0.0);
+}
+END_TEST
+
+START_TEST(coining) {
+  /* A5, nu = 0.495, {p,F} JST to 54 % remaining height */
+  outcome a = run("coining", NULL, 0, 0.00002);
+  ck_assert_msg(a.stable && a.t >= 0.00046 - 1e-15, "%s", a.reason);
+  ck_assert(a.j_min > 0.0);
+}
+END_TEST
+
+START_TEST(energy_indicator_fires_without_jst) {
+  /* A1 without any stabilisation grows energy (hourglass modes) and the
+   * verdict must say so; with eps4_p = 1/8 it stays stable */
+  const char *none[] = {"method.jst.eps4_p=0", "time.end=0.3"};
+  outcome a = run("twisting_column", none, 2, 0.005);
+  ck_assert_msg(!a.stable && strstr(a.reason, "energy growth"),
+                "no-JST run not flagged: %s", a.reason);
+  outcome b = run("twisting_column", NULL, 0, 0.005);
+  ck_assert_msg(b.stable, "%s", b.reason);
+  ck_assert(b.e1 < b.e0);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("stability");
+  TCase *tc = tcase_create("hard cases");
+  tcase_set_timeout(tc, 600);
+  tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
+  tcase_add_test(tc, twisting_column_nearly_incompressible);
+  tcase_add_test(tc, punch_nearly_incompressible);
+  tcase_add_test(tc, coining);
+  tcase_add_test(tc, energy_indicator_fires_without_jst);
+  suite_add_tcase(s, tc);
+  return sph_test_run(s);
+}
