@@ -195,6 +195,78 @@ START_TEST(option_errors) {
 }
 END_TEST
 
+/* B3 cable: tip velocity history of scenes/cable.yaml against the
+ * d'Alembert solution (c = 5000 m/s; the tip velocity drops from 5 to 0 at
+ * t = 0.0005 s, to -5 at 0.0035 s, back to 0 at 0.0045 s; the tip
+ * displacement rests at 0.0025 m in between). */
+typedef struct cable_result {
+  double t_down, t_neg, t_up, u_plateau, vmin;
+} cable_result;
+
+static double crossing(const double *t, const double *v, int n, double level,
+                       int down, double after) {
+  for (int i = 1; i < n; ++i)
+    if (t[i] > after && (down ? (v[i - 1] > level && v[i] <= level)
+                              : (v[i - 1] < level && v[i] >= level)))
+      return t[i - 1] +
+             (t[i] - t[i - 1]) * (v[i - 1] - level) / (v[i - 1] - v[i]);
+  return NAN;
+}
+
+static cable_result cable(const char *eps2) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/scenes/cable.yaml", SPH_SOURCE_DIR);
+  const char *sets[] = {eps2};
+  sph_scene *s;
+  sph_sim *sim;
+  sph_error err;
+  ck_assert(sph_scene_load(&s, path, sets, 1, &err) == SPH_OK);
+  ck_assert(sph_sim_create(&sim, s, &err) == SPH_OK);
+  size_t tip = 0;
+  const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+  for (size_t a = 0; a < sim->ps->n; ++a)
+    if (X[3 * a] == 10.0 && X[3 * a + 1] == 0.1 && X[3 * a + 2] == 0.1)
+      tip = a;
+  ck_assert(X[3 * tip] == 10.0);
+  enum { N = 121 };
+  static double t[N], v[N], u[N];
+  for (int k = 0; k < N; ++k) {
+    double next = 0.00005 * k;
+    while (sim->t < next - 1e-15)
+      ck_assert(sph_sim_step(sim, next - sim->t, &err) == SPH_OK);
+    sim->method->derive(sim, &err);
+    t[k] = sim->t;
+    v[k] = sim->ps->field[SPH_FIELD_VELOCITY][3 * tip];
+    u[k] = sim->ps->field[SPH_FIELD_DISPLACEMENT][3 * tip];
+  }
+  cable_result r = {crossing(t, v, N, 2.5, 1, 0.0),
+                    crossing(t, v, N, -2.5, 1, 0.001),
+                    crossing(t, v, N, -2.5, 0, 0.0036), u[40], 0.0};
+  for (int k = 0; k < N; ++k)
+    r.vmin = fmin(r.vmin, v[k]);
+  printf("cable %s: arrivals %.5g %.5g %.5g s (exact 0.0005 0.0035 0.0045), "
+         "plateau u %.5g m (0.0025), min v %.4g m/s (-5)\n",
+         eps2, r.t_down, r.t_neg, r.t_up, r.u_plateau, r.vmin);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+  return r;
+}
+
+START_TEST(cable_against_dalembert) {
+  cable_result a = cable("method.jst.eps2_p=0.125");
+  /* the front is smeared over a few particle spacings (0.1 m = 2e-5 s) */
+  ck_assert(fabs(a.t_down - 0.0005) < 0.02 * 0.0005);
+  ck_assert(fabs(a.t_neg - 0.0035) < 0.02 * 0.0035);
+  ck_assert(fabs(a.t_up - 0.0045) < 0.02 * 0.0045);
+  ck_assert(fabs(a.u_plateau - 0.0025) < 0.02 * 0.0025);
+  /* eps2_p = 1/8 keeps the undershoot of the reflected front small, while
+   * without it the front rings by tens of per cent */
+  cable_result b = cable("method.jst.eps2_p=0");
+  ck_assert_msg(a.vmin > -5.0 * 1.10, "eps2 1/8 undershoot %g", a.vmin);
+  ck_assert_msg(b.vmin < -5.0 * 1.30, "eps2 0 undershoot only %g", b.vmin);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("tl_jst");
   TCase *tc = tcase_create("tl_jst");
@@ -205,6 +277,7 @@ int main(void) {
   tcase_add_test(tc, variants_agree);
   tcase_add_test(tc, terms_follow_the_scene);
   tcase_add_test(tc, option_errors);
+  tcase_add_test(tc, cable_against_dalembert);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }
