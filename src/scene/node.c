@@ -119,6 +119,23 @@ typedef struct loader {
 } loader;
 
 static sph_status convert(loader *L, yaml_node_t *y, int line, int col,
+                          int depth, sph_node **out);
+
+/* Converts y and appends it to parent under key (NULL in sequences). */
+static sph_status add_child(loader *L, sph_node *parent, const char *key,
+                            yaml_node_t *y, int line, int col, int depth) {
+  sph_node *child;
+  sph_status st = convert(L, y, line, col, depth, &child);
+  if (st != SPH_OK)
+    return st;
+  if (node_append(parent, key, child)) {
+    sph_node_destroy(child);
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+  }
+  return SPH_OK;
+}
+
+static sph_status convert(loader *L, yaml_node_t *y, int line, int col,
                           int depth, sph_node **out) {
   *out = NULL;
   if (depth > MAX_DEPTH)
@@ -146,22 +163,13 @@ static sph_status convert(loader *L, yaml_node_t *y, int line, int col,
     for (yaml_node_item_t *it = y->data.sequence.items.start;
          it < y->data.sequence.items.top; ++it) {
       yaml_node_t *c = yaml_document_get_node(L->doc, *it);
-      sph_node *child;
-      sph_status st = convert(L, c, (int)c->start_mark.line + 1,
-                              (int)c->start_mark.column + 1, depth + 1, &child);
+      sph_status st = add_child(L, n, NULL, c, (int)c->start_mark.line + 1,
+                                (int)c->start_mark.column + 1, depth + 1);
       if (st != SPH_OK) {
         sph_node_destroy(n);
         return st;
       }
-      if (node_append(n, NULL, child)) {
-        sph_node_destroy(child);
-        sph_node_destroy(n);
-        n = NULL;
-        break;
-      }
     }
-    if (!n)
-      break;
     *out = n;
     return SPH_OK;
   case YAML_MAPPING_NODE:
@@ -189,21 +197,12 @@ static sph_status convert(loader *L, yaml_node_t *y, int line, int col,
                               "%d)",
                               key, first);
         }
-      sph_node *child;
-      sph_status st = convert(L, v, kl, kc, depth + 1, &child);
+      sph_status st = add_child(L, n, key, v, kl, kc, depth + 1);
       if (st != SPH_OK) {
         sph_node_destroy(n);
         return st;
       }
-      if (node_append(n, key, child)) {
-        sph_node_destroy(child);
-        sph_node_destroy(n);
-        n = NULL;
-        break;
-      }
     }
-    if (!n)
-      break;
     *out = n;
     return SPH_OK;
   default:
