@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "methods/registry_impl.h"
+#include "methods/tl_iact.h"
 #include "methods/tl_jst/tl_jst_iact.h"
 #include "methods/tl_jst/tl_jst_impl.h"
 #include "sph/corrections.h"
@@ -36,7 +37,7 @@ static void compute_stress(tl_jst *m, long n) {
   for (long a = 0; a < n; ++a) {
     double Ha[9], Ja;
     strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
-    sph_material_stress(m->mat[a], m->F + 9 * a, Ha, Ja, m->P + 9 * a);
+    sph_material_stress(m->ref.mat[a], m->F + 9 * a, Ha, Ja, m->P + 9 * a);
   }
 }
 
@@ -47,7 +48,7 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
                              sph_error *err) {
   tl_jst *m = ctx;
   sph_sim *sim = m->sim;
-  const sph_neighbors *nl = m->nl;
+  const sph_neighbors *nl = m->ref.nl;
   const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
@@ -55,19 +56,21 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double G[9] = {0}, T[3] = {0, 0, 0};
-    double inv_rho0 = 1.0 / m->rho0[a];
+    double inv_rho0 = 1.0 / m->ref.rho0[a];
     const double *pa = m->p + 3 * a, *Pa = m->P + 9 * a;
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      const double *g = m->grad + 3 * k;
-      tl_jst_iact_velocity_gradient(G, V[b], inv_rho0, pa, m->p + 3 * b, g);
+      const double *g = m->ref.grad + 3 * k;
+      tl_iact_gradient(G, V[b], pa, m->p + 3 * b, g);
       if (m->force == TL_JST_CONSERVATIVE)
-        tl_jst_iact_force(T, V[b], Pa, m->P + 9 * b, g,
-                          m->grad + 3 * m->rev[k]);
+        tl_iact_force(T, V[b], Pa, m->P + 9 * b, g,
+                      m->ref.grad + 3 * m->ref.rev[k]);
       else
         tl_jst_iact_force_symmetric(T, V[b], Pa, m->P + 9 * b, g);
     }
     /* geometric conservation laws (eq. 41b-d) and dx = p / rho0 */
+    for (int k = 0; k < 9; ++k)
+      G[k] *= inv_rho0;
     memcpy(m->dF + 9 * a, G, sizeof G);
     if (m->fields == TL_JST_PFHJ)
       sph_mat3_tensor_cross(m->F + 9 * a, G, m->dH + 9 * a);
@@ -89,7 +92,7 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
       for (int c = 0; c < 3; ++c)
         m->xmoment[3 * a + c] =
             m->x0[3 * a + c] +
-            0.5 * dt * (m->p0[3 * a + c] + m->p[3 * a + c]) / m->rho0[a];
+            0.5 * dt * (m->p0[3 * a + c] + m->p[3 * a + c]) / m->ref.rho0[a];
     xm = m->xmoment;
   }
   sim->timers[m->timer_force].seconds += sph_wtime() - t0;
@@ -121,7 +124,7 @@ static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
 static double tl_jst_stable_dt(sph_sim *sim) {
   const tl_jst *m = sim->method_data;
   /* eq. 44 with h_min the particle spacing and the materials' c_p */
-  return m->cfl * sim->dp / m->cp;
+  return m->cfl * sim->dp / m->ref.cp;
 }
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
@@ -137,68 +140,24 @@ static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   tl_jst *m = sim->method_data;
-  sph_particles *ps = sim->ps;
-  long n = (long)ps->n;
-  compute_stress(m, n);
-  double *X = ps->field[SPH_FIELD_POSITION0];
-  double *v = ps->field[SPH_FIELD_VELOCITY],
-         *u = ps->field[SPH_FIELD_DISPLACEMENT];
-  double *Jf = ps->field[SPH_FIELD_JACOBIAN],
-         *sig = ps->field[SPH_FIELD_STRESS];
-  double *pr = ps->field[SPH_FIELD_PRESSURE],
-         *vm = ps->field[SPH_FIELD_VON_MISES];
-#pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    for (int c = 0; c < 3; ++c) {
-      v[3 * a + c] = m->p[3 * a + c] / m->rho0[a];
-      u[3 * a + c] = m->x[3 * a + c] - X[3 * a + c];
-    }
-    double Ha[9], Ja, S[9], Ft[9];
-    strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
-    Jf[a] = Ja;
-    /* Cauchy stress sigma = P F^T / det F */
-    sph_mat3_transpose(m->F + 9 * a, Ft);
-    sph_mat3_mul(m->P + 9 * a, Ft, S);
-    double detF = sph_mat3_det(m->F + 9 * a);
-    for (int k = 0; k < 9; ++k)
-      S[k] /= detF;
-    memcpy(sig + 9 * a, S, sizeof S);
-    double mean = sph_mat3_trace(S) / 3.0, dev2 = 0.0;
-    pr[a] = mean; /* hydrostatic pressure of seed 000 eq. 11 */
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        double d = S[3 * i + j] - (i == j) * mean;
-        dev2 += d * d;
-      }
-    vm[a] = sqrt(1.5 * dev2);
-  }
+  compute_stress(m, (long)sim->ps->n);
+  tl_derive(sim, &m->ref, m->x, m->p, m->F,
+            m->fields == TL_JST_PF ? NULL : m->J, m->P);
   return SPH_OK;
 }
 
 static void tl_jst_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_jst *m = sim->method_data;
-  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
-  double ek = 0.0, es = 0.0;
-  for (size_t a = 0; a < sim->ps->n; ++a) {
-    double Ha[9], Ja;
-    strain_measures(m, m->F, m->H, m->J, a, Ha, &Ja);
-    ek += V[a] * sph_vec3_dot(m->p + 3 * a, m->p + 3 * a) / (2 * m->rho0[a]);
-    es += V[a] * sph_material_energy(m->mat[a], m->F + 9 * a, Ha, Ja);
-  }
-  *kinetic = ek;
-  *strain = es;
+  tl_energy(sim, &m->ref, m->p, m->F, m->fields == TL_JST_PFHJ ? m->H : NULL,
+            m->fields == TL_JST_PF ? NULL : m->J, kinetic, strain);
 }
 
 static void tl_jst_destroy(sph_sim *sim) {
   tl_jst *m = sim->method_data;
   if (!m)
     return;
-  sph_neighbors_destroy(m->nl);
-  free(m->grad);
+  tl_reference_destroy(&m->ref);
   free(m->lap);
-  free(m->rev);
-  free(m->mat);
-  free(m->rho0);
   free(m->x0);
   free(m->p0);
   free(m->F0);
@@ -238,37 +197,6 @@ static sph_status parse_choice(sph_node *opt, const char *key,
 static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
   *p = calloc(count ? count : 1, sizeof **p);
   return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "tl-jst arrays");
-}
-
-/* slot of (b -> a) for every slot (a -> b): binary search in b's list */
-static sph_status reverse_slots(tl_jst *m, sph_error *err) {
-  const sph_neighbors *nl = m->nl;
-  m->rev = malloc((nl->count ? nl->count : 1) * sizeof *m->rev);
-  if (!m->rev)
-    return sph_error_set(err, SPH_ERR_NOMEM, "reverse slots");
-  long n = (long)nl->n, missing = 0;
-#pragma omp parallel for schedule(static) reduction(+ : missing)
-  for (long a = 0; a < n; ++a)
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
-      size_t b = (size_t)nl->index[k];
-      size_t lo = nl->offset[b], hi = nl->offset[b + 1];
-      while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (nl->index[mid] < (int32_t)a)
-          lo = mid + 1;
-        else
-          hi = mid;
-      }
-      if (lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a)
-        m->rev[k] = lo;
-      else
-        ++missing;
-    }
-  if (missing)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "neighbour lists are not "
-                         "symmetric");
-  return SPH_OK;
 }
 
 static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
@@ -347,27 +275,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "tl-jst yet; use a roller");
     }
 
-  /* per-particle material, density, wave speed */
-  m->mat = malloc((n ? n : 1) * sizeof *m->mat);
-  SPH_TRY(m->mat ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "materials"));
-  SPH_TRY(alloc_zero(&m->rho0, n, err));
-  for (size_t a = 0; a < n; ++a) {
-    m->mat[a] = &s->materials[s->bodies[ps->body[a]].material];
-    m->rho0[a] = m->mat[a]->density;
-  }
-  for (size_t b = 0; b < s->nbodies; ++b) {
-    double c = sph_material_wave_speed(&s->materials[s->bodies[b].material]);
-    m->cp = c > m->cp ? c : m->cp;
-  }
-
-  /* state fields */
-  sph_field need[] = {SPH_FIELD_POSITION,  SPH_FIELD_MOMENTUM,
-                      SPH_FIELD_DEFGRAD,   SPH_FIELD_JACOBIAN,
-                      SPH_FIELD_PK1,       SPH_FIELD_DISPLACEMENT,
-                      SPH_FIELD_STRESS,    SPH_FIELD_PRESSURE,
-                      SPH_FIELD_VON_MISES, SPH_FIELD_MASS};
-  for (size_t i = 0; i < sizeof need / sizeof *need; ++i)
-    SPH_TRY(sph_particles_require(ps, need[i], err));
+  /* reference configuration, state fields and the variant's extra fields */
+  SPH_TRY(tl_reference_create(&m->ref, sim, err));
   if (m->fields == TL_JST_PFHJ)
     SPH_TRY(sph_particles_require(ps, SPH_FIELD_COFACTOR, err));
   m->x = ps->field[SPH_FIELD_POSITION];
@@ -376,58 +285,36 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->H = ps->field[SPH_FIELD_COFACTOR];
   m->J = ps->field[SPH_FIELD_JACOBIAN];
   m->P = ps->field[SPH_FIELD_PK1];
-  for (size_t a = 0; a < n; ++a) {
-    memcpy(m->x + 3 * a, ps->field[SPH_FIELD_POSITION0] + 3 * a,
-           3 * sizeof(double));
-    for (int c = 0; c < 3; ++c)
-      m->p[3 * a + c] = m->rho0[a] * ps->field[SPH_FIELD_VELOCITY][3 * a + c];
-    sph_mat3_identity(m->F + 9 * a);
-    if (m->H)
-      sph_mat3_identity(m->H + 9 * a);
-    m->J[a] = 1.0;
-    ps->field[SPH_FIELD_MASS][a] = m->rho0[a] * ps->field[SPH_FIELD_VOLUME0][a];
-  }
-
-  /* neighbours and corrections in the reference configuration */
-  int timer = sph_sim_add_timer(sim, "corrections");
-  double t0 = sph_wtime();
-  SPH_TRY(sph_neighbors_create(&m->nl, err));
-  SPH_TRY(sph_neighbors_build(m->nl, ps->field[SPH_FIELD_POSITION0], n,
-                              s->dimension, sim->kernel.support, ps->body,
-                              SPH_PAIRS_SAME_BODY, err));
-  SPH_TRY(reverse_slots(m, err));
+  for (size_t a = 0; m->H && a < n; ++a)
+    sph_mat3_identity(m->H + 9 * a);
   sph_cloud cloud = {.n = n,
                      .dim = s->dimension,
                      .x = ps->field[SPH_FIELD_POSITION0],
                      .volume = ps->field[SPH_FIELD_VOLUME0],
                      .id = ps->id,
-                     .nl = m->nl,
+                     .nl = m->ref.nl,
                      .kernel = &sim->kernel};
-  SPH_TRY(alloc_zero(&m->grad, 3 * m->nl->count, err));
-  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, m->grad, NULL,
-                                  NULL, err));
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
-    SPH_TRY(alloc_zero(&m->lap, m->nl->count, err));
+    SPH_TRY(alloc_zero(&m->lap, m->ref.nl->count, err));
     if (lp == 0) {
       SPH_TRY(sph_correction_laplacian(&cloud, m->lap, err));
     } else {
       /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
       const double *X = ps->field[SPH_FIELD_POSITION0];
       for (size_t a = 0; a < n; ++a)
-        for (size_t k = m->nl->offset[a]; k < m->nl->offset[a + 1]; ++k) {
-          size_t b = (size_t)m->nl->index[k];
+        for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1];
+             ++k) {
+          size_t b = (size_t)m->ref.nl->index[k];
           double r[3], r2 = 0.0;
           for (int c = 0; c < 3; ++c) {
             r[c] = X[3 * a + c] - X[3 * b + c];
             r2 += r[c] * r[c];
           }
-          m->lap[k] = -2.0 * sph_vec3_dot(r, m->grad + 3 * k) / r2;
+          m->lap[k] = -2.0 * sph_vec3_dot(r, m->ref.grad + 3 * k) / r2;
         }
     }
   }
-  sim->timers[timer].seconds += sph_wtime() - t0;
-  sim->timers[timer].calls++;
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
 
   /* integrator storage */
@@ -457,17 +344,17 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (amp)
     SPH_TRY(angular_momentum_projection_create(sim, err));
   if (need_p) {
-    jst_params jp = {m->nl, m->lap, 3, e2p, e4p, m->cp, sim->dp, jproj};
+    jst_params jp = {m->ref.nl, m->lap, 3, e2p, e4p, m->ref.cp, sim->dp, jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (need_j) {
-    jst_params jp = {m->nl, m->lap, 1, e2j, e4j, m->cp, sim->dp, jproj};
+    jst_params jp = {m->ref.nl, m->lap, 1, e2j, e4j, m->ref.cp, sim->dp, jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (s->has_body_force)
-    SPH_TRY(body_force_create(sim, m->rho0, err));
+    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
   if (s->nboundaries) {
-    SPH_TRY(essential_bc_create(sim, m->rho0, err));
+    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
     /* the initial state honours the constraints */
     SPH_TRY(tl_jst_constrain(m, 0.0, err));
   }

@@ -5,8 +5,7 @@
 #include <stddef.h>
 
 #include "integrators/integrator_impl.h"
-#include "sph/material.h"
-#include "sph/neighbors.h"
+#include "methods/tl_common_impl.h"
 
 typedef enum tl_jst_fields { TL_JST_PF, TL_JST_PFJ, TL_JST_PFHJ } tl_jst_fields;
 typedef enum tl_jst_force {
@@ -18,13 +17,8 @@ typedef struct tl_jst {
   tl_jst_fields fields;
   tl_jst_force force;
   double cfl;
-  double cp;                /* largest p-wave speed of the materials */
-  sph_neighbors *nl;        /* reference configuration, same body only */
-  double *grad;             /* corrected gradient per slot (3) */
-  double *lap;              /* Laplacian weight per slot (NULL if unused) */
-  size_t *rev;              /* slot of (b -> a) for slot (a -> b) */
-  const sph_material **mat; /* per particle */
-  double *rho0;             /* per particle */
+  tl_reference ref; /* neighbours, gradients, materials */
+  double *lap;      /* Laplacian weight per slot (NULL if unused) */
   /* state (particle fields) and its RK copies and rates */
   double *x, *p, *F, *H, *J;
   double *x0, *p0, *F0, *H0, *J0;
