@@ -26,4 +26,20 @@ typedef struct sph_ode {
  * u* = u^n + dt f(u^n); u** = u* + dt f(u*); u^{n+1} = (u^n + u**) / 2. */
 sph_status sph_tvd_rk2_step(sph_ode *ode, double t, double dt, sph_error *err);
 
+/* Leap-frog (kick-drift-kick) for positions x and momenta per reference
+ * volume p = rho0 v: `rates` fills dp from the current x and p; the rates
+ * of the end of a step are reused at the start of the next. */
+typedef struct sph_leapfrog {
+  size_t n;
+  double *x, *p, *dp;
+  const double *rho0;
+  int have_rates;
+  sph_status (*rates)(void *ctx, double t, sph_error *err);
+  sph_status (*constrain)(void *ctx, double t, sph_error *err);
+  void *ctx;
+} sph_leapfrog;
+
+sph_status sph_leapfrog_step(sph_leapfrog *lf, double t, double dt,
+                             sph_error *err);
+
 #endif

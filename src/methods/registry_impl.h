@@ -7,5 +7,6 @@
 #include "sph/sim.h"
 
 extern const sph_method_ops tl_jst_method_ops;
+extern const sph_method_ops tl_csph_method_ops;
 
 #endif

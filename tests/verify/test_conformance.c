@@ -12,6 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "sph/material.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
 #include "sph/sink.h"
@@ -59,14 +60,21 @@ START_TEST(rest_stays_at_rest) {
     sph_sim *sim = make_sim((*m)->name, "", &s);
     advance(sim, 20);
     const sph_particles *ps = sim->ps;
-    double worst = 0.0;
-    for (size_t i = 0; i < 3 * ps->n; ++i)
-      worst = fmax(worst, fabs(ps->field[SPH_FIELD_VELOCITY][i]) +
-                              fabs(ps->field[SPH_FIELD_DISPLACEMENT][i]));
+    double wv = 0.0, wu = 0.0, ws = 0.0;
+    for (size_t i = 0; i < 3 * ps->n; ++i) {
+      wv = fmax(wv, fabs(ps->field[SPH_FIELD_VELOCITY][i]));
+      wu = fmax(wu, fabs(ps->field[SPH_FIELD_DISPLACEMENT][i]));
+    }
     for (size_t i = 0; i < 9 * ps->n; ++i)
-      worst = fmax(worst, fabs(ps->field[SPH_FIELD_STRESS][i]));
-    ck_assert_msg(worst == 0.0, "%s: state at rest changed by %g", (*m)->name,
-                  worst);
+      ws = fmax(ws, fabs(ps->field[SPH_FIELD_STRESS][i]));
+    /* methods that evolve F keep the rest state exactly; F = grad_0 x
+     * reproduces I only to round-off, so the stress is eps * E at most */
+    double E = s->materials[0].youngs_modulus;
+    double c = sph_material_wave_speed(&s->materials[0]);
+    ck_assert_msg(ws <= 1e-12 * E && wv <= 1e-12 * c && wu <= 1e-12,
+                  "%s: rest state changed: stress %g, velocity %g, "
+                  "displacement %g",
+                  (*m)->name, ws, wv, wu);
     sph_sim_destroy(sim);
     sph_scene_destroy(s);
   }
@@ -92,10 +100,13 @@ START_TEST(translation_stays_rigid) {
       }
     for (size_t i = 0; i < 9 * ps->n; ++i)
       ws = fmax(ws, fabs(ps->field[SPH_FIELD_STRESS][i]));
-    /* velocity differences are exactly zero, so F stays I: only the
-     * position update rounds (|u| ~ 3 m/s * t) */
-    ck_assert_msg(wv < 1e-13, "%s: velocity changed by %g", (*m)->name, wv);
-    ck_assert_msg(ws == 0.0, "%s: stress %g in a translation", (*m)->name, ws);
+    /* a translation carries no strain: F = I to round-off, so the stress
+     * is at most eps * E and the velocity changes at round-off level */
+    double E = s->materials[0].youngs_modulus;
+    ck_assert_msg(wv < 1e-12 * 3.0, "%s: velocity changed by %g", (*m)->name,
+                  wv);
+    ck_assert_msg(ws <= 1e-12 * E, "%s: stress %g in a translation", (*m)->name,
+                  ws);
     ck_assert_msg(wu < 1e-13, "%s: displacement not uniform (%g)", (*m)->name,
                   wu);
     sph_sim_destroy(sim);

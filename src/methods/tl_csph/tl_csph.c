@@ -1,0 +1,170 @@
+/* tl-csph: the classical displacement-based total-Lagrangian corrected SPH
+ * of seed 001 sec. 2 (Vidal, Bonet, Huerta 2007, after Bonet and
+ * Kulasegaram): F = grad_0 x with the corrected gradient (eq. 8-9), the
+ * Galerkin internal force T_i = sum_j V_j P_j G_i(X_j) (eq. 11, written in
+ * the conservative pair form of seed 000 eq. 29c), m a = E - T, leap-frog.
+ * No stabilisation: this is the baseline the JST papers compare against. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/registry_impl.h"
+#include "methods/tl_csph/tl_csph_iact.h"
+#include "methods/tl_csph/tl_csph_impl.h"
+#include "sph/tensor.h"
+#include "terms/terms_impl.h"
+
+/* F from positions and P from the material, for every particle */
+static void deformation_and_stress(tl_csph *m, long n) {
+  const sph_neighbors *nl = m->ref.nl;
+  const double *V = m->sim->ps->field[SPH_FIELD_VOLUME0];
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double F[9] = {0}, H[9];
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      tl_csph_iact_deformation(F, V[b], m->x + 3 * a, m->x + 3 * b,
+                               m->ref.grad + 3 * k);
+    }
+    memcpy(m->F + 9 * a, F, sizeof F);
+    sph_mat3_cofactor(F, H);
+    sph_material_stress(m->ref.mat[a], F, H, sph_mat3_det(F), m->P + 9 * a);
+  }
+}
+
+static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
+  tl_csph *m = ctx;
+  sph_sim *sim = m->sim;
+  const sph_neighbors *nl = m->ref.nl;
+  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
+  long n = (long)sim->ps->n;
+  double t0 = sph_wtime();
+  deformation_and_stress(m, n);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double T[3] = {0, 0, 0};
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      tl_iact_force(T, V[b], m->P + 9 * a, m->P + 9 * b, m->ref.grad + 3 * k,
+                    m->ref.grad + 3 * m->ref.rev[k]);
+    }
+    for (int c = 0; c < 3; ++c)
+      m->dp[3 * a + c] = -T[c];
+  }
+  sim->timers[m->timer_force].seconds += sph_wtime() - t0;
+  sim->timers[m->timer_force].calls++;
+  sph_stage s = {
+      .t = t, .x = m->x, .p = m->p, .F = m->F, .x_moment = m->x, .dp = m->dp};
+  return sph_sim_terms_rates(sim, &s, err);
+}
+
+static sph_status tl_csph_constrain(void *ctx, double t, sph_error *err) {
+  tl_csph *m = ctx;
+  sph_stage s = {.t = t, .x = m->x, .p = m->p, .F = m->F};
+  return sph_sim_terms_constrain(m->sim, &s, err);
+}
+
+static double tl_csph_stable_dt(sph_sim *sim) {
+  const tl_csph *m = sim->method_data;
+  return m->cfl * sim->dp / m->ref.cp;
+}
+
+static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
+  tl_csph *m = sim->method_data;
+  SPH_TRY(sph_leapfrog_step(&m->lf, sim->t, dt, err));
+  long n3 = 3 * (long)sim->ps->n;
+  for (long i = 0; i < n3; ++i)
+    if (!isfinite(m->p[i]) || !isfinite(m->x[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "nan: non-finite state at particle %ld", i / 3);
+  return SPH_OK;
+}
+
+static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
+  tl_csph *m = sim->method_data;
+  deformation_and_stress(m, (long)sim->ps->n);
+  tl_derive(sim, &m->ref, m->x, m->p, m->F, NULL, m->P);
+  return SPH_OK;
+}
+
+static void tl_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
+  tl_csph *m = sim->method_data;
+  tl_energy(sim, &m->ref, m->p, m->F, NULL, NULL, kinetic, strain);
+}
+
+static void tl_csph_destroy(sph_sim *sim) {
+  tl_csph *m = sim->method_data;
+  if (!m)
+    return;
+  tl_reference_destroy(&m->ref);
+  free(m->dp);
+  free(m);
+  sim->method_data = NULL;
+}
+
+static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  static const char *const keys[] = {"name", "cfl", "integrator", NULL};
+  SPH_TRY(sph_node_check_keys(opt, keys, err));
+  tl_csph *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph");
+  sim->method_data = m;
+  m->sim = sim;
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
+  if (!(m->cfl > 0.0 && m->cfl <= 1.0))
+    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
+                          "cfl must be in (0, 1], got %g", m->cfl);
+  const char *integ;
+  SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
+  if (strcmp(integ, "leapfrog"))
+    return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
+                          "'%s' is not one of: leapfrog", integ);
+  const sph_scene *s = sim->scene;
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY) {
+      char key[48];
+      snprintf(key, sizeof key, "boundaries[%zu]", k);
+      return sph_error_at(err, SPH_ERR_UNSUPPORTED, s->path,
+                          s->boundaries[k].line, s->boundaries[k].col, key,
+                          "mirror (symmetry) planes are not supported by "
+                          "tl-csph yet; use a roller");
+    }
+  SPH_TRY(tl_reference_create(&m->ref, sim, err));
+  sph_particles *ps = sim->ps;
+  m->x = ps->field[SPH_FIELD_POSITION];
+  m->p = ps->field[SPH_FIELD_MOMENTUM];
+  m->F = ps->field[SPH_FIELD_DEFGRAD];
+  m->P = ps->field[SPH_FIELD_PK1];
+  m->dp = calloc(3 * ps->n + 3, sizeof *m->dp);
+  if (!m->dp)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph rates");
+  m->timer_force = sph_sim_add_timer(sim, "internal_force");
+  m->lf = (sph_leapfrog){.n = ps->n,
+                         .x = m->x,
+                         .p = m->p,
+                         .dp = m->dp,
+                         .rho0 = m->ref.rho0,
+                         .rates = tl_csph_rates,
+                         .constrain = tl_csph_constrain,
+                         .ctx = m};
+  if (s->has_body_force)
+    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
+  if (s->nboundaries) {
+    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
+    SPH_TRY(tl_csph_constrain(m, 0.0, err));
+  }
+  return SPH_OK;
+}
+
+const sph_method_ops tl_csph_method_ops = {
+    .name = "tl-csph",
+    .title = "Total-Lagrangian corrected SPH, displacement-based (baseline)",
+    .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 2, eq. 8-11",
+    .setup = tl_csph_setup,
+    .stable_dt = tl_csph_stable_dt,
+    .step = tl_csph_step,
+    .derive = tl_csph_derive,
+    .energy = tl_csph_energy,
+    .destroy = tl_csph_destroy,
+};

@@ -1,0 +1,18 @@
+/* Private state of the tl-csph method (seed 001 sec. 2). */
+#ifndef SPH_TL_CSPH_IMPL_H
+#define SPH_TL_CSPH_IMPL_H
+
+#include "integrators/integrator_impl.h"
+#include "methods/tl_common_impl.h"
+
+typedef struct tl_csph {
+  tl_reference ref;
+  double cfl;
+  double *x, *p, *F, *P; /* particle fields */
+  double *dp;            /* rate of momentum */
+  sph_leapfrog lf;
+  int timer_force;
+  struct sph_sim *sim;
+} tl_csph;
+
+#endif
