@@ -62,12 +62,26 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
       size_t b = (size_t)nl->index[k];
       const double *g = m->ref.grad + 3 * k;
       tl_iact_gradient(G, V[b], pa, m->p + 3 * b, g);
-      if (m->force == TL_JST_CONSERVATIVE)
+      switch (m->force) {
+      case TL_JST_CONSERVATIVE:
         tl_iact_force(T, V[b], Pa, m->P + 9 * b, g,
                       m->ref.grad + 3 * m->ref.rev[k]);
-      else
+        break;
+      case TL_JST_SYMMETRIC:
         tl_jst_iact_force_symmetric(T, V[b], Pa, m->P + 9 * b, g);
+        break;
+      case TL_JST_EQ30:
+        tl_jst_iact_force_symmetric(T, V[b], Pa, m->P + 9 * b,
+                                    m->fgrad + 3 * k);
+        break;
+      case TL_JST_EQ31:
+        tl_jst_iact_force_kernel(T, V[b], m->P + 9 * b,
+                                 m->fgrad + 3 * m->ref.rev[k]);
+        break;
+      }
     }
+    if (m->force == TL_JST_EQ31) /* the b = a term of eq. 31 */
+      tl_jst_iact_force_kernel(T, V[a], Pa, m->fgrad_self + 3 * a);
     /* geometric conservation laws (eq. 41b-d) and dx = p / rho0 */
     for (int k = 0; k < 9; ++k)
       G[k] *= inv_rho0;
@@ -158,6 +172,8 @@ static void tl_jst_destroy(sph_sim *sim) {
     return;
   tl_reference_destroy(&m->ref);
   free(m->lap);
+  free(m->fgrad);
+  free(m->fgrad_self);
   free(m->x0);
   free(m->p0);
   free(m->F0);
@@ -223,7 +239,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 
   /* options */
   static const char *const fields[] = {"pF", "pFJ", "pFHJ", NULL};
-  static const char *const forces[] = {"conservative", "symmetric", NULL};
+  static const char *const forces[] = {"conservative", "symmetric", "eq30",
+                                       "eq31", NULL};
   static const char *const laps[] = {"corrected", "gradient", NULL};
   static const char *const integrators[] = {"tvd-rk2", NULL};
   static const char *const bcs[] = {"direct", NULL};
@@ -294,6 +311,13 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .id = ps->id,
                      .nl = m->ref.nl,
                      .kernel = &sim->kernel};
+  if (m->force == TL_JST_EQ30 || m->force == TL_JST_EQ31) {
+    SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
+    SPH_TRY(alloc_zero(&m->fgrad_self, 3 * n, err));
+    SPH_TRY(sph_correction_gradient(
+        &cloud, m->force == TL_JST_EQ30 ? SPH_GRAD_UNCORRECTED : SPH_GRAD_W1,
+        m->fgrad, m->fgrad_self, NULL, err));
+  }
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
     SPH_TRY(alloc_zero(&m->lap, m->ref.nl->count, err));

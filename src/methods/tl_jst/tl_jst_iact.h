@@ -1,5 +1,7 @@
-/* Pair interaction specific to tl-jst: the symmetric force of seed 003
- * eq. 11 (the shared ones are in methods/tl_iact.h). */
+/* Pair interactions specific to tl-jst: the symmetric force of seed 003
+ * eq. 11 (also eq. 30 of seed 000 with the uncorrected gradient) and the
+ * kernel-gradient force of seed 000 eq. 31; the shared ones are in
+ * methods/tl_iact.h. */
 #ifndef SPH_TL_JST_IACT_H
 #define SPH_TL_JST_IACT_H
 
@@ -18,6 +20,17 @@ static inline void tl_jst_iact_force_symmetric(double T[3], double Vb,
   sph_mat3_vec(S, g_ab, u);
   for (int i = 0; i < 3; ++i)
     T[i] -= Vb * u[i];
+}
+
+/* Kernel-gradient force of seed 000 eq. 31: T_a += V_b P_b gradW~_a(X_b)
+ * (b = a included) */
+static inline void tl_jst_iact_force_kernel(double T[3], double Vb,
+                                            const double Pb[9],
+                                            const double g_ba[3]) {
+  double u[3];
+  sph_mat3_vec(Pb, g_ba, u);
+  for (int i = 0; i < 3; ++i)
+    T[i] += Vb * u[i];
 }
 
 #endif

@@ -9,16 +9,20 @@
 
 typedef enum tl_jst_fields { TL_JST_PF, TL_JST_PFJ, TL_JST_PFHJ } tl_jst_fields;
 typedef enum tl_jst_force {
-  TL_JST_CONSERVATIVE,
-  TL_JST_SYMMETRIC
+  TL_JST_CONSERVATIVE, /* seed 000 eq. 29c / 42 */
+  TL_JST_SYMMETRIC,    /* seed 003 eq. 11 */
+  TL_JST_EQ30,         /* seed 000 eq. 30: uncorrected gradient */
+  TL_JST_EQ31          /* seed 000 eq. 31: corrected gradient of W~ */
 } tl_jst_force;
 
 typedef struct tl_jst {
   tl_jst_fields fields;
   tl_jst_force force;
   double cfl;
-  tl_reference ref; /* neighbours, gradients, materials */
-  double *lap;      /* Laplacian weight per slot (NULL if unused) */
+  tl_reference ref;   /* neighbours, gradients, materials */
+  double *lap;        /* Laplacian weight per slot (NULL if unused) */
+  double *fgrad;      /* force gradients per slot (eq. 30, 31 only) */
+  double *fgrad_self; /* eq. 31: grad W~1_a(X_a) per particle */
   /* state (particle fields) and its RK copies and rates */
   double *x, *p, *F, *H, *J;
   double *x0, *p0, *F0, *H0, *J0;
