@@ -195,6 +195,10 @@ void sph_scene_destroy(sph_scene *s);
 sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
                                      sph_error *err);
 
+/* Whether a boundary imposes values on particles (clamp, roller,
+ * velocity); symmetry planes are handled with mirror images instead. */
+int sph_scene_has_essential_bc(const sph_scene *s);
+
 /* Smallest particle spacing over the bodies. */
 double sph_scene_min_spacing(const sph_scene *s);
 

@@ -78,6 +78,23 @@ typedef struct sph_timer {
   unsigned long calls;
 } sph_timer;
 
+/* Mirror (ghost) images of real particles across symmetry planes (seed 000
+ * sec. 8.2, BENCHMARKS D.1): particle n_real + g is the image of src[g].
+ * A vector of the image is S v with S = diag(vsign[3g..3g+2]); a scalar's
+ * departure from its reference value flips by ssign[g]. Terms that read
+ * neighbours' values refresh images with sph_mirror_vector/scalar. */
+typedef struct sph_mirror {
+  size_t n_real, n_ghost;
+  const int32_t *src;
+  const signed char *vsign;
+  const signed char *ssign;
+} sph_mirror;
+
+/* Image values of a vector (ncomp 3) or scalar (ncomp 1, about `ref`) field
+ * whose real entries are set. */
+void sph_mirror_vector(const sph_mirror *m, double *v);
+void sph_mirror_scalar(const sph_mirror *m, double *f, double ref);
+
 #define SPH_MAX_TERMS 16
 #define SPH_MAX_TIMERS 8
 
@@ -96,6 +113,8 @@ struct sph_sim {
   sph_timer timers[SPH_MAX_TIMERS];
   int ntimers;
   int threads;
+  const sph_mirror *mirror; /* NULL without symmetry planes */
+  int initial_defgrad;      /* DEFGRAD holds the initial F (reference) */
 };
 
 /* Method table lookup (the registry lists every method once). */

@@ -160,3 +160,20 @@ void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]) {
     }
   }
 }
+
+void sph_mirror_vector(const sph_mirror *m, double *v) {
+  long ng = (long)m->n_ghost;
+#pragma omp parallel for schedule(static)
+  for (long g = 0; g < ng; ++g) {
+    size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;
+    for (int c = 0; c < 3; ++c)
+      v[3 * d + c] = m->vsign[3 * g + c] * v[3 * s + c];
+  }
+}
+
+void sph_mirror_scalar(const sph_mirror *m, double *f, double ref) {
+  long ng = (long)m->n_ghost;
+#pragma omp parallel for schedule(static)
+  for (long g = 0; g < ng; ++g)
+    f[m->n_real + (size_t)g] = ref + m->ssign[g] * (f[(size_t)m->src[g]] - ref);
+}

@@ -1,6 +1,9 @@
 /* Shared set-up and output of the total-Lagrangian methods (seed 000
  * sec. 3.2, seed 001 sec. 2): the reference configuration is fixed, so the
- * neighbour lists and corrected gradients are computed once here. */
+ * neighbour lists and corrected gradients are computed once here, including
+ * mirror images across symmetry (normal component negated) and
+ * skew-symmetry (tangential components negated) planes, as BENCHMARKS.md
+ * D.1 recommends for the swinging cube of seed 000 sec. 8.2. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +11,191 @@
 #include "methods/tl_common_impl.h"
 #include "sph/corrections.h"
 #include "sph/tensor.h"
+
+/* ---- mirror images
+ * ------------------------------------------------------------ */
+
+typedef struct plane {
+  int axis, side, body;
+  double at;
+  int sigma; /* +1 symmetry, -1 skew-symmetry */
+  size_t done;
+} plane;
+
+typedef struct hash {
+  int64_t *key; /* 3 per slot */
+  char *used;
+  size_t cap;
+} hash;
+
+static uint64_t hash3(const int64_t k[3]) {
+  uint64_t h = 1469598103934665603ull;
+  for (int c = 0; c < 3; ++c)
+    h = (h ^ (uint64_t)k[c]) * 1099511628211ull;
+  return h;
+}
+
+/* Inserts k; returns 0 if it was already present, 1 if new, -1 if full. */
+static int hash_insert(hash *h, const int64_t k[3]) {
+  for (size_t i = hash3(k) % h->cap, tries = 0; tries < h->cap;
+       i = (i + 1) % h->cap, ++tries) {
+    if (!h->used[i]) {
+      h->used[i] = 1;
+      memcpy(h->key + 3 * i, k, 3 * sizeof *k);
+      return 1;
+    }
+    if (!memcmp(h->key + 3 * i, k, 3 * sizeof *k))
+      return 0;
+  }
+  return -1;
+}
+
+static sph_status grow_points(tl_reference *r, size_t need, size_t *cap,
+                              sph_error *err) {
+  if (need <= *cap)
+    return SPH_OK;
+  size_t c = 2 * need;
+  double *X = realloc(r->X, 3 * c * sizeof *X), *V;
+  if (X)
+    r->X = X;
+  V = realloc(r->V, c * sizeof *V);
+  if (V)
+    r->V = V;
+  int32_t *b = realloc(r->body, c * sizeof *b), *s;
+  if (b)
+    r->body = b;
+  s = realloc(r->src, c * sizeof *s);
+  if (s)
+    r->src = s;
+  signed char *vs = realloc(r->vsign, 3 * c), *rs, *ss;
+  if (vs)
+    r->vsign = vs;
+  rs = realloc(r->rsign, 3 * c);
+  if (rs)
+    r->rsign = rs;
+  ss = realloc(r->ssign, c);
+  if (ss)
+    r->ssign = ss;
+  if (!X || !V || !b || !s || !vs || !rs || !ss)
+    return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+  *cap = c;
+  return SPH_OK;
+}
+
+/* Real points first, then images of every point within two supports of a
+ * plane on its domain side; two passes over the planes complete edges,
+ * corners and periodic images, duplicates are skipped. */
+static sph_status build_images(tl_reference *r, sph_sim *sim, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_particles *ps = sim->ps;
+  size_t n = ps->n, cap = 0;
+  plane planes[32];
+  int np = 0;
+  SPH_TRY(grow_points(r, n + 1, &cap, err));
+  memcpy(r->X, ps->field[SPH_FIELD_POSITION0], 3 * n * sizeof(double));
+  memcpy(r->V, ps->field[SPH_FIELD_VOLUME0], n * sizeof(double));
+  memcpy(r->body, ps->body, n * sizeof(int32_t));
+  for (size_t a = 0; a < n; ++a) {
+    r->src[a] = (int32_t)a;
+    memset(r->vsign + 3 * a, 1, 3);
+    memset(r->rsign + 3 * a, 1, 3);
+    r->ssign[a] = 1;
+  }
+  for (size_t k = 0; k < s->nboundaries && np < 32; ++k) {
+    const sph_boundary *bc = &s->boundaries[k];
+    if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
+      continue;
+    plane *pl = &planes[np++];
+    pl->axis = bc->select.axis;
+    pl->at = bc->select.at;
+    pl->body = bc->select.body;
+    pl->sigma = bc->kind == SPH_BC_SYMMETRY ? 1 : -1;
+    pl->done = 0;
+    double mean = 0.0;
+    size_t cnt = 0;
+    for (size_t a = 0; a < n; ++a)
+      if (pl->body < 0 || ps->body[a] == pl->body) {
+        mean += r->X[3 * a + pl->axis];
+        ++cnt;
+      }
+    pl->side = cnt && mean / (double)cnt < pl->at ? -1 : 1;
+  }
+  size_t total = n;
+  if (np) {
+    double layer = 2.0 * sim->kernel.support, q = 1e-6 * sim->dp;
+    hash h = {0};
+    h.cap = 16 * n + 1024;
+    h.key = malloc(3 * h.cap * sizeof *h.key);
+    h.used = calloc(h.cap, 1);
+    if (!h.key || !h.used) {
+      free(h.key);
+      free(h.used);
+      return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+    }
+    sph_status st = SPH_OK;
+    int full = 0;
+    for (size_t a = 0; a < n; ++a) {
+      int64_t key[3];
+      for (int c = 0; c < 3; ++c)
+        key[c] = llround(r->X[3 * a + c] / q);
+      hash_insert(&h, key);
+    }
+    for (int pass = 0; pass < 2 && st == SPH_OK; ++pass)
+      for (int k = 0; k < np && st == SPH_OK; ++k) {
+        plane *pl = &planes[k];
+        size_t count = total;
+        for (size_t i = pl->done; i < count && st == SPH_OK; ++i) {
+          if (pl->body >= 0 && r->body[i] != pl->body)
+            continue;
+          double d = (r->X[3 * i + pl->axis] - pl->at) * pl->side;
+          if (d <= 0.0 || d >= layer)
+            continue;
+          double Xn[3] = {r->X[3 * i], r->X[3 * i + 1], r->X[3 * i + 2]};
+          Xn[pl->axis] = 2.0 * pl->at - Xn[pl->axis];
+          int64_t key[3];
+          for (int c = 0; c < 3; ++c)
+            key[c] = llround(Xn[c] / q);
+          int ins = hash_insert(&h, key);
+          if (ins < 0)
+            full = 1;
+          if (ins <= 0)
+            continue;
+          if ((st = grow_points(r, total + 1, &cap, err)) != SPH_OK)
+            break;
+          memcpy(r->X + 3 * total, Xn, sizeof Xn);
+          r->V[total] = r->V[i];
+          r->body[total] = r->body[i];
+          r->src[total] = r->src[i];
+          r->ssign[total] = (signed char)(r->ssign[i] * pl->sigma);
+          for (int c = 0; c < 3; ++c) {
+            r->rsign[3 * total + c] =
+                (signed char)(r->rsign[3 * i + c] * (c == pl->axis ? -1 : 1));
+            r->vsign[3 * total + c] =
+                (signed char)(r->ssign[total] * r->rsign[3 * total + c]);
+          }
+          ++total;
+        }
+        pl->done = count;
+      }
+    free(h.key);
+    free(h.used);
+    if (st == SPH_OK && full)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "mirror image table is full");
+    if (st != SPH_OK)
+      return st;
+  }
+  r->n = n;
+  r->n_ext = total;
+  r->mirror = (sph_mirror){.n_real = n,
+                           .n_ghost = total - n,
+                           .src = r->src + n,
+                           .vsign = r->vsign + 3 * n,
+                           .ssign = r->ssign + n};
+  return SPH_OK;
+}
+
+/* ---- reference configuration
+ * -------------------------------------------------- */
 
 /* slot of (b -> a) for every slot (a -> b): binary search in b's list */
 static sph_status reverse_slots(tl_reference *ref, sph_error *err) {
@@ -40,20 +228,31 @@ static sph_status reverse_slots(tl_reference *ref, sph_error *err) {
   return SPH_OK;
 }
 
+sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
+                              double **out, sph_error *err) {
+  *out = calloc(ncomp * ref->n_ext + 1, sizeof **out);
+  return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
+}
+
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim,
                                sph_error *err) {
   memset(ref, 0, sizeof *ref);
   const sph_scene *s = sim->scene;
   sph_particles *ps = sim->ps;
-  size_t n = ps->n;
+  int timer = sph_sim_add_timer(sim, "corrections");
+  double t0 = sph_wtime();
+  SPH_TRY(build_images(ref, sim, err));
+  size_t n = ref->n, ne = ref->n_ext;
+  if (ne > n)
+    sim->mirror = &ref->mirror;
 
-  /* per-particle material and density, the fastest wave */
-  ref->mat = malloc((n ? n : 1) * sizeof *ref->mat);
-  ref->rho0 = malloc((n ? n : 1) * sizeof *ref->rho0);
+  /* per-point material and density, the fastest wave */
+  ref->mat = malloc(ne * sizeof *ref->mat);
+  ref->rho0 = malloc(ne * sizeof *ref->rho0);
   if (!ref->mat || !ref->rho0)
     return sph_error_set(err, SPH_ERR_NOMEM, "materials");
-  for (size_t a = 0; a < n; ++a) {
-    ref->mat[a] = &s->materials[s->bodies[ps->body[a]].material];
+  for (size_t a = 0; a < ne; ++a) {
+    ref->mat[a] = &s->materials[s->bodies[ref->body[a]].material];
     ref->rho0[a] = ref->mat[a]->density;
   }
   for (size_t b = 0; b < s->nbodies; ++b) {
@@ -61,7 +260,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim,
     ref->cp = c > ref->cp ? c : ref->cp;
   }
 
-  /* state and output fields, in the reference state */
+  /* state and output fields */
   static const sph_field need[] = {SPH_FIELD_POSITION,  SPH_FIELD_MOMENTUM,
                                    SPH_FIELD_DEFGRAD,   SPH_FIELD_JACOBIAN,
                                    SPH_FIELD_PK1,       SPH_FIELD_DISPLACEMENT,
@@ -69,41 +268,62 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim,
                                    SPH_FIELD_VON_MISES, SPH_FIELD_MASS};
   for (size_t i = 0; i < sizeof need / sizeof *need; ++i)
     SPH_TRY(sph_particles_require(ps, need[i], err));
-  for (size_t a = 0; a < n; ++a) {
-    memcpy(ps->field[SPH_FIELD_POSITION] + 3 * a,
-           ps->field[SPH_FIELD_POSITION0] + 3 * a, 3 * sizeof(double));
-    for (int c = 0; c < 3; ++c)
-      ps->field[SPH_FIELD_MOMENTUM][3 * a + c] =
-          ref->rho0[a] * ps->field[SPH_FIELD_VELOCITY][3 * a + c];
-    sph_mat3_identity(ps->field[SPH_FIELD_DEFGRAD] + 9 * a);
-    ps->field[SPH_FIELD_JACOBIAN][a] = 1.0;
-    ps->field[SPH_FIELD_MASS][a] =
-        ref->rho0[a] * ps->field[SPH_FIELD_VOLUME0][a];
+  ref->owns_state = ne > n;
+  if (ref->owns_state) {
+    SPH_TRY(tl_reference_alloc(ref, 3, &ref->x, err));
+    SPH_TRY(tl_reference_alloc(ref, 3, &ref->p, err));
+    SPH_TRY(tl_reference_alloc(ref, 9, &ref->F, err));
+    SPH_TRY(tl_reference_alloc(ref, 1, &ref->J, err));
+    SPH_TRY(tl_reference_alloc(ref, 9, &ref->P, err));
+  } else {
+    ref->x = ps->field[SPH_FIELD_POSITION];
+    ref->p = ps->field[SPH_FIELD_MOMENTUM];
+    ref->F = ps->field[SPH_FIELD_DEFGRAD];
+    ref->J = ps->field[SPH_FIELD_JACOBIAN];
+    ref->P = ps->field[SPH_FIELD_PK1];
   }
+  for (size_t a = 0; a < n; ++a) {
+    memcpy(ref->x + 3 * a, ref->X + 3 * a, 3 * sizeof(double));
+    for (int c = 0; c < 3; ++c)
+      ref->p[3 * a + c] =
+          ref->rho0[a] * ps->field[SPH_FIELD_VELOCITY][3 * a + c];
+    if (sim->initial_defgrad)
+      memcpy(ref->F + 9 * a, ps->field[SPH_FIELD_DEFGRAD] + 9 * a,
+             9 * sizeof(double));
+    else
+      sph_mat3_identity(ref->F + 9 * a);
+    ref->J[a] = sph_mat3_det(ref->F + 9 * a);
+    ps->field[SPH_FIELD_MASS][a] = ref->rho0[a] * ref->V[a];
+  }
+  tl_mirror_refresh(ref, ref->x, ref->p, ref->F, NULL, ref->J);
 
   /* neighbours and corrected gradients in the reference configuration */
-  int timer = sph_sim_add_timer(sim, "corrections");
-  double t0 = sph_wtime();
   SPH_TRY(sph_neighbors_create(&ref->nl, err));
-  SPH_TRY(sph_neighbors_build(ref->nl, ps->field[SPH_FIELD_POSITION0], n,
-                              s->dimension, sim->kernel.support, ps->body,
+  SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
+                              sim->kernel.support, ref->body,
                               SPH_PAIRS_SAME_BODY, err));
   SPH_TRY(reverse_slots(ref, err));
-  sph_cloud cloud = {.n = n,
+  int64_t *id = malloc(ne * sizeof *id);
+  if (!id)
+    return sph_error_set(err, SPH_ERR_NOMEM, "ids");
+  for (size_t a = 0; a < ne; ++a)
+    id[a] = ps->id[ref->src[a]];
+  sph_cloud cloud = {.n = ne,
                      .dim = s->dimension,
-                     .x = ps->field[SPH_FIELD_POSITION0],
-                     .volume = ps->field[SPH_FIELD_VOLUME0],
-                     .id = ps->id,
+                     .x = ref->X,
+                     .volume = ref->V,
+                     .id = id,
                      .nl = ref->nl,
                      .kernel = &sim->kernel};
   ref->grad = calloc(3 * ref->nl->count + 3, sizeof *ref->grad);
-  if (!ref->grad)
-    return sph_error_set(err, SPH_ERR_NOMEM, "corrected gradients");
-  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, ref->grad, NULL,
-                                  NULL, err));
+  sph_status st = ref->grad
+                      ? sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED,
+                                                ref->grad, NULL, NULL, err)
+                      : sph_error_set(err, SPH_ERR_NOMEM, "gradients");
+  free(id);
   sim->timers[timer].seconds += sph_wtime() - t0;
   sim->timers[timer].calls++;
-  return SPH_OK;
+  return st;
 }
 
 void tl_reference_destroy(tl_reference *ref) {
@@ -112,21 +332,72 @@ void tl_reference_destroy(tl_reference *ref) {
   free(ref->rev);
   free(ref->mat);
   free(ref->rho0);
+  free(ref->X);
+  free(ref->V);
+  free(ref->body);
+  free(ref->src);
+  free(ref->vsign);
+  free(ref->rsign);
+  free(ref->ssign);
+  if (ref->owns_state) {
+    free(ref->x);
+    free(ref->p);
+    free(ref->F);
+    free(ref->J);
+    free(ref->P);
+  }
   memset(ref, 0, sizeof *ref);
 }
 
-void tl_derive(sph_sim *sim, const tl_reference *ref, const double *x,
-               const double *p, const double *F, const double *J,
-               const double *P) {
+/* image of a two-point tensor: I + sigma R (A - I) R */
+static inline void mirror_tensor(const double *A, double *out, int sigma,
+                                 const signed char *R) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out[3 * i + j] =
+          (i == j) + sigma * R[i] * R[j] * (A[3 * i + j] - (i == j));
+}
+
+void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
+                       double *H, double *J) {
+  long n = (long)ref->n, ne = (long)ref->n_ext;
+#pragma omp parallel for schedule(static)
+  for (long g = n; g < ne; ++g) {
+    size_t s = (size_t)ref->src[g];
+    const signed char *S = ref->vsign + 3 * g, *R = ref->rsign + 3 * g;
+    int sigma = ref->ssign[g];
+    for (int c = 0; c < 3; ++c) {
+      x[3 * g + c] =
+          ref->X[3 * g + c] + S[c] * (x[3 * s + c] - ref->X[3 * s + c]);
+      p[3 * g + c] = S[c] * p[3 * s + c];
+    }
+    mirror_tensor(F + 9 * s, F + 9 * g, sigma, R);
+    if (H)
+      mirror_tensor(H + 9 * s, H + 9 * g, sigma, R);
+    if (J)
+      J[g] = 1.0 + sigma * (J[s] - 1.0);
+  }
+}
+
+void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
+               const double *J) {
   sph_particles *ps = sim->ps;
   long n = (long)ps->n;
   const double *X = ps->field[SPH_FIELD_POSITION0];
+  const double *x = ref->x, *p = ref->p, *F = ref->F, *P = ref->P;
   double *v = ps->field[SPH_FIELD_VELOCITY];
   double *u = ps->field[SPH_FIELD_DISPLACEMENT];
   double *Jf = ps->field[SPH_FIELD_JACOBIAN];
   double *sig = ps->field[SPH_FIELD_STRESS];
   double *pr = ps->field[SPH_FIELD_PRESSURE];
   double *vm = ps->field[SPH_FIELD_VON_MISES];
+  if (ref->owns_state) {
+    memcpy(ps->field[SPH_FIELD_POSITION], x, 3 * (size_t)n * sizeof *x);
+    memcpy(ps->field[SPH_FIELD_MOMENTUM], p, 3 * (size_t)n * sizeof *p);
+    memcpy(ps->field[SPH_FIELD_DEFGRAD], F, 9 * (size_t)n * sizeof *F);
+    memcpy(ps->field[SPH_FIELD_PK1], P, 9 * (size_t)n * sizeof *P);
+  }
+  (void)H;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     for (int c = 0; c < 3; ++c) {
@@ -134,8 +405,7 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *x,
       u[3 * a + c] = x[3 * a + c] - X[3 * a + c];
     }
     double detF = sph_mat3_det(F + 9 * a);
-    if (Jf != J)
-      Jf[a] = J ? J[a] : detF;
+    Jf[a] = J ? J[a] : detF;
     /* Cauchy stress sigma = P F^T / det F */
     double Ft[9], S[9];
     sph_mat3_transpose(F + 9 * a, Ft);
@@ -154,12 +424,11 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *x,
   }
 }
 
-void tl_energy(sph_sim *sim, const tl_reference *ref, const double *p,
-               const double *F, const double *H, const double *J,
-               double *kinetic, double *strain) {
-  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
+void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
+               const double *J, double *kinetic, double *strain) {
+  const double *V = ref->V, *p = ref->p, *F = ref->F;
   double ek = 0.0, es = 0.0;
-  for (size_t a = 0; a < sim->ps->n; ++a) {
+  for (size_t a = 0; a < ref->n; ++a) {
     double Ha[9];
     const double *Fa = F + 9 * a;
     if (H)
@@ -172,4 +441,5 @@ void tl_energy(sph_sim *sim, const tl_reference *ref, const double *p,
   }
   *kinetic = ek;
   *strain = es;
+  (void)sim;
 }

@@ -1,42 +1,65 @@
 /* What the total-Lagrangian methods share: the reference configuration
  * (same-body neighbours, corrected kernel gradients of seed 000 eq. 21 /
- * seed 001 eq. 8, reverse slots), per-particle material and density, the
- * derived output fields and the energy. */
+ * seed 001 eq. 8, reverse slots), mirror images across symmetry planes,
+ * per-particle material and density, the state arrays, the derived output
+ * fields and the energy. */
 #ifndef SPH_TL_COMMON_IMPL_H
 #define SPH_TL_COMMON_IMPL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "sph/material.h"
 #include "sph/neighbors.h"
 #include "sph/sim.h"
 
 typedef struct tl_reference {
-  sph_neighbors *nl;        /* reference configuration, same body only */
+  size_t n, n_ext;          /* real particles, real + mirror images */
+  double *X;                /* reference positions (3 n_ext) */
+  double *V;                /* volumes (n_ext) */
+  int32_t *body;            /* bodies (n_ext) */
+  sph_neighbors *nl;        /* over all n_ext points, same body only */
   double *grad;             /* corrected gradient per slot (3) */
   size_t *rev;              /* slot of (b -> a) for slot (a -> b) */
-  const sph_material **mat; /* per particle */
-  double *rho0;             /* per particle */
+  const sph_material **mat; /* per point (n_ext) */
+  double *rho0;             /* per point (n_ext) */
   double cp;                /* largest p-wave speed of the materials */
+  /* state, n_ext entries each; the particle fields themselves when there
+   * are no images */
+  double *x, *p, *F, *J, *P;
+  int owns_state;
+  /* mirror images */
+  sph_mirror mirror;
+  int32_t *src;
+  signed char *vsign, *rsign, *ssign;
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as
- * "corrections") and allocates the state fields every TL method carries:
- * POSITION (= X), MOMENTUM (= rho0 v0), DEFGRAD (= I), JACOBIAN (= 1), PK1,
- * MASS and the derived output fields. */
+ * "corrections"), with images across the scene's symmetry and
+ * skew-symmetry planes in a layer two kernel supports thick, and sets the
+ * initial state: x = X, p = rho0 v0, F = I (or the scene reference's
+ * initial F), J = det F. */
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, sph_error *err);
 void tl_reference_destroy(tl_reference *ref);
 
-/* Derived fields from the state: velocity, displacement, J, Cauchy stress,
- * pressure tr(sigma)/3 (seed 000 eq. 11), von Mises. H and J may be NULL
- * (then cof F and det F); P must hold the stress of the state. */
-void tl_derive(sph_sim *sim, const tl_reference *ref, const double *x,
-               const double *p, const double *F, const double *J,
-               const double *P);
+/* Extra per-point state of n_ext entries (e.g. the cofactor). */
+sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
+                              double **out, sph_error *err);
 
-/* Kinetic and strain energy; H and J may be NULL (cof F, det F). */
-void tl_energy(sph_sim *sim, const tl_reference *ref, const double *p,
-               const double *F, const double *H, const double *J,
-               double *kinetic, double *strain);
+/* Sets the images' state from their sources: positions, momenta, F (and H
+ * when not NULL) as I + sigma R (A - I) R, J as 1 + sigma (J - 1). */
+void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
+                       double *H, double *J);
+
+/* Derived fields of the real particles: velocity, displacement, J, Cauchy
+ * stress, pressure tr(sigma)/3 (seed 000 eq. 11), von Mises; copies the
+ * state into the particle fields when the method keeps its own arrays.
+ * J may be NULL (det F); P must hold the stress of the state. */
+void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
+               const double *J);
+
+/* Kinetic and strain energy of the real particles; H and J may be NULL. */
+void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
+               const double *J, double *kinetic, double *strain);
 
 #endif

@@ -937,6 +937,15 @@ void sph_scene_destroy(sph_scene *s) {
   free(s);
 }
 
+int sph_scene_has_essential_bc(const sph_scene *s) {
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (s->boundaries[k].kind == SPH_BC_CLAMP ||
+        s->boundaries[k].kind == SPH_BC_ROLLER ||
+        s->boundaries[k].kind == SPH_BC_VELOCITY)
+      return 1;
+  return 0;
+}
+
 double sph_scene_min_spacing(const sph_scene *s) {
   double dp = INFINITY;
   for (size_t b = 0; b < s->nbodies; ++b)

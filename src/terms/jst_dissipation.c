@@ -37,7 +37,7 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
                             sph_error *err) {
   jst *j = term->data;
   const sph_particles *ps = sim->ps;
-  const double *V = ps->field[SPH_FIELD_VOLUME0];
+  const double *V = j->p.V;
   long n = (long)ps->n;
   int nc = j->p.ncomp;
   const double *u = nc == 3 ? stage->p : stage->J;
@@ -45,13 +45,20 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   double c2 = j->p.eps2 * j->p.cp * j->p.h;
   double c4 = j->p.eps4 * j->p.cp * j->p.h * j->p.h * j->p.h;
   laplacian(j, V, u, j->lu, n);
+  if (sim->mirror) { /* the images' Laplacians mirror their sources' */
+    if (nc == 3)
+      sph_mirror_vector(sim->mirror, j->lu);
+    else
+      sph_mirror_scalar(sim->mirror, j->lu, 0.0);
+  }
   if (c4 != 0.0)
     laplacian(j, V, j->lu, j->d, n); /* L[L[u]] */
   for (long i = 0; i < nc * n; ++i)
     j->d[i] = c2 * j->lu[i] - (c4 != 0.0 ? c4 * j->d[i] : 0.0);
   if (j->p.project) {
     if (nc == 3) {
-      sph_momentum_projection(ps->n, V, stage->x_moment, ps->body,
+      sph_momentum_projection(ps->n, ps->field[SPH_FIELD_VOLUME0],
+                              stage->x_moment, ps->body,
                               (int)sim->scene->nbodies, j->d);
     } else {
       for (size_t b = 0; b < sim->scene->nbodies; ++b) {
@@ -99,7 +106,7 @@ static const sph_term_ops jst_j_ops = {
 sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
                                   sph_error *err) {
   jst *j = calloc(1, sizeof *j);
-  size_t len = (size_t)p->ncomp * (sim->ps->n ? sim->ps->n : 1);
+  size_t len = (size_t)p->ncomp * (p->nl->n ? p->nl->n : 1);
   if (!j || !(j->lu = calloc(len, sizeof(double))) ||
       !(j->d = calloc(len, sizeof(double)))) {
     if (j) {

@@ -27,8 +27,9 @@ sph_status angular_momentum_projection_create(sph_sim *sim, sph_error *err);
  * Laplacian weights of `nl`; h is the particle spacing, cp the p-wave
  * speed. */
 typedef struct jst_params {
-  const sph_neighbors *nl;
+  const sph_neighbors *nl; /* may list mirror images beyond the particles */
   const double *lap;
+  const double *V; /* volumes of every point of nl */
   int ncomp;
   double eps2, eps4, cp, h;
   int project;

@@ -14,21 +14,31 @@
 #include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
-/* F from positions and P from the material, for every particle */
+/* F from positions for the particles, images mirrored, P for every point */
 static void deformation_and_stress(tl_csph *m, long n) {
-  const sph_neighbors *nl = m->ref.nl;
-  const double *V = m->sim->ps->field[SPH_FIELD_VOLUME0];
+  tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
+  long ne = (long)ref->n_ext;
+  if (ne > n) /* image positions and momenta from their sources */
+    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double F[9] = {0}, H[9];
+    double F[9] = {0};
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      tl_csph_iact_deformation(F, V[b], m->x + 3 * a, m->x + 3 * b,
-                               m->ref.grad + 3 * k);
+      tl_csph_iact_deformation(F, ref->V[b], m->x + 3 * a, m->x + 3 * b,
+                               ref->grad + 3 * k);
     }
     memcpy(m->F + 9 * a, F, sizeof F);
-    sph_mat3_cofactor(F, H);
-    sph_material_stress(m->ref.mat[a], F, H, sph_mat3_det(F), m->P + 9 * a);
+  }
+  if (ne > n) /* the images' F mirror their sources' */
+    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    double H[9];
+    sph_mat3_cofactor(m->F + 9 * a, H);
+    sph_material_stress(ref->mat[a], m->F + 9 * a, H,
+                        sph_mat3_det(m->F + 9 * a), m->P + 9 * a);
   }
 }
 
@@ -36,7 +46,7 @@ static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
   tl_csph *m = ctx;
   sph_sim *sim = m->sim;
   const sph_neighbors *nl = m->ref.nl;
-  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
+  const double *V = m->ref.V;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   deformation_and_stress(m, n);
@@ -83,13 +93,13 @@ static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
 static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
   deformation_and_stress(m, (long)sim->ps->n);
-  tl_derive(sim, &m->ref, m->x, m->p, m->F, NULL, m->P);
+  tl_derive(sim, &m->ref, NULL, NULL);
   return SPH_OK;
 }
 
 static void tl_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_csph *m = sim->method_data;
-  tl_energy(sim, &m->ref, m->p, m->F, NULL, NULL, kinetic, strain);
+  tl_energy(sim, &m->ref, NULL, NULL, kinetic, strain);
 }
 
 static void tl_csph_destroy(sph_sim *sim) {
@@ -120,22 +130,12 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
                           "'%s' is not one of: leapfrog", integ);
   const sph_scene *s = sim->scene;
-  for (size_t k = 0; k < s->nboundaries; ++k)
-    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
-        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY) {
-      char key[48];
-      snprintf(key, sizeof key, "boundaries[%zu]", k);
-      return sph_error_at(err, SPH_ERR_UNSUPPORTED, s->path,
-                          s->boundaries[k].line, s->boundaries[k].col, key,
-                          "mirror (symmetry) planes are not supported by "
-                          "tl-csph yet; use a roller");
-    }
   SPH_TRY(tl_reference_create(&m->ref, sim, err));
   sph_particles *ps = sim->ps;
-  m->x = ps->field[SPH_FIELD_POSITION];
-  m->p = ps->field[SPH_FIELD_MOMENTUM];
-  m->F = ps->field[SPH_FIELD_DEFGRAD];
-  m->P = ps->field[SPH_FIELD_PK1];
+  m->x = m->ref.x;
+  m->p = m->ref.p;
+  m->F = m->ref.F;
+  m->P = m->ref.P;
   m->dp = calloc(3 * ps->n + 3, sizeof *m->dp);
   if (!m->dp)
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph rates");
@@ -150,7 +150,7 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                          .ctx = m};
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (s->nboundaries) {
+  if (sph_scene_has_essential_bc(s)) {
     SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
     SPH_TRY(tl_csph_constrain(m, 0.0, err));
   }

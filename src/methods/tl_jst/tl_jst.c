@@ -32,6 +32,14 @@ static inline void strain_measures(const tl_jst *m, const double *F,
   *Ja = m->fields == TL_JST_PF ? sph_mat3_det(Fa) : J[a];
 }
 
+/* mirror images take their sources' state */
+static void refresh_images(tl_jst *m) {
+  if (m->ref.n_ext > m->ref.n)
+    tl_mirror_refresh(&m->ref, m->x, m->p, m->F,
+                      m->fields == TL_JST_PFHJ ? m->H : NULL,
+                      m->fields == TL_JST_PF ? NULL : m->J);
+}
+
 static void compute_stress(tl_jst *m, long n) {
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
@@ -49,10 +57,11 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   tl_jst *m = ctx;
   sph_sim *sim = m->sim;
   const sph_neighbors *nl = m->ref.nl;
-  const double *V = sim->ps->field[SPH_FIELD_VOLUME0];
+  const double *V = m->ref.V;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
-  compute_stress(m, n);
+  refresh_images(m);
+  compute_stress(m, (long)m->ref.n_ext);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double G[9] = {0}, T[3] = {0, 0, 0};
@@ -154,15 +163,16 @@ static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   tl_jst *m = sim->method_data;
-  compute_stress(m, (long)sim->ps->n);
-  tl_derive(sim, &m->ref, m->x, m->p, m->F,
-            m->fields == TL_JST_PF ? NULL : m->J, m->P);
+  refresh_images(m);
+  compute_stress(m, (long)m->ref.n_ext);
+  tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
+            m->fields == TL_JST_PF ? NULL : m->J);
   return SPH_OK;
 }
 
 static void tl_jst_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_jst *m = sim->method_data;
-  tl_energy(sim, &m->ref, m->p, m->F, m->fields == TL_JST_PFHJ ? m->H : NULL,
+  tl_energy(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
             m->fields == TL_JST_PF ? NULL : m->J, kinetic, strain);
 }
 
@@ -171,6 +181,7 @@ static void tl_jst_destroy(sph_sim *sim) {
   if (!m)
     return;
   tl_reference_destroy(&m->ref);
+  free(m->H);
   free(m->lap);
   free(m->fgrad);
   free(m->fgrad_self);
@@ -281,39 +292,28 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     if (eps[i] < 0.0)
       return sph_node_error(jst, err, SPH_ERR_RANGE,
                             "JST coefficients must be >= 0");
-  for (size_t k = 0; k < s->nboundaries; ++k)
-    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
-        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY) {
-      char key[48];
-      snprintf(key, sizeof key, "boundaries[%zu]", k);
-      return sph_error_at(err, SPH_ERR_UNSUPPORTED, s->path,
-                          s->boundaries[k].line, s->boundaries[k].col, key,
-                          "mirror (symmetry) planes are not supported by "
-                          "tl-jst yet; use a roller");
-    }
-
-  /* reference configuration, state fields and the variant's extra fields */
+  /* reference configuration (with mirror images) and the state */
   SPH_TRY(tl_reference_create(&m->ref, sim, err));
-  if (m->fields == TL_JST_PFHJ)
-    SPH_TRY(sph_particles_require(ps, SPH_FIELD_COFACTOR, err));
-  m->x = ps->field[SPH_FIELD_POSITION];
-  m->p = ps->field[SPH_FIELD_MOMENTUM];
-  m->F = ps->field[SPH_FIELD_DEFGRAD];
-  m->H = ps->field[SPH_FIELD_COFACTOR];
-  m->J = ps->field[SPH_FIELD_JACOBIAN];
-  m->P = ps->field[SPH_FIELD_PK1];
-  for (size_t a = 0; m->H && a < n; ++a)
-    sph_mat3_identity(m->H + 9 * a);
-  sph_cloud cloud = {.n = n,
+  size_t ne = m->ref.n_ext;
+  m->x = m->ref.x;
+  m->p = m->ref.p;
+  m->F = m->ref.F;
+  m->J = m->ref.J;
+  m->P = m->ref.P;
+  if (m->fields == TL_JST_PFHJ) {
+    SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->H, err));
+    for (size_t a = 0; a < ne; ++a)
+      sph_mat3_cofactor(m->F + 9 * a, m->H + 9 * a);
+  }
+  sph_cloud cloud = {.n = ne,
                      .dim = s->dimension,
-                     .x = ps->field[SPH_FIELD_POSITION0],
-                     .volume = ps->field[SPH_FIELD_VOLUME0],
-                     .id = ps->id,
+                     .x = m->ref.X,
+                     .volume = m->ref.V,
                      .nl = m->ref.nl,
                      .kernel = &sim->kernel};
   if (m->force == TL_JST_EQ30 || m->force == TL_JST_EQ31) {
     SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
-    SPH_TRY(alloc_zero(&m->fgrad_self, 3 * n, err));
+    SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
     SPH_TRY(sph_correction_gradient(
         &cloud, m->force == TL_JST_EQ30 ? SPH_GRAD_UNCORRECTED : SPH_GRAD_W1,
         m->fgrad, m->fgrad_self, NULL, err));
@@ -325,8 +325,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
       SPH_TRY(sph_correction_laplacian(&cloud, m->lap, err));
     } else {
       /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
-      const double *X = ps->field[SPH_FIELD_POSITION0];
-      for (size_t a = 0; a < n; ++a)
+      const double *X = m->ref.X;
+      for (size_t a = 0; a < ne; ++a)
         for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1];
              ++k) {
           size_t b = (size_t)m->ref.nl->index[k];
@@ -368,16 +368,18 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (amp)
     SPH_TRY(angular_momentum_projection_create(sim, err));
   if (need_p) {
-    jst_params jp = {m->ref.nl, m->lap, 3, e2p, e4p, m->ref.cp, sim->dp, jproj};
+    jst_params jp = {m->ref.nl, m->lap,    m->ref.V, 3,    e2p,
+                     e4p,       m->ref.cp, sim->dp,  jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (need_j) {
-    jst_params jp = {m->ref.nl, m->lap, 1, e2j, e4j, m->ref.cp, sim->dp, jproj};
+    jst_params jp = {m->ref.nl, m->lap,    m->ref.V, 1,    e2j,
+                     e4j,       m->ref.cp, sim->dp,  jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (s->nboundaries) {
+  if (sph_scene_has_essential_bc(s)) {
     SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
     /* the initial state honours the constraints */
     SPH_TRY(tl_jst_constrain(m, 0.0, err));
