@@ -113,8 +113,9 @@ struct sph_sim {
   sph_timer timers[SPH_MAX_TIMERS];
   int ntimers;
   int threads;
-  const sph_mirror *mirror; /* NULL without symmetry planes */
-  int initial_defgrad;      /* DEFGRAD holds the initial F (reference) */
+  const sph_mirror *mirror;        /* NULL without symmetry planes */
+  struct sph_reference *reference; /* the scene's reference, or NULL */
+  int initial_defgrad;             /* DEFGRAD holds the initial F (reference) */
 };
 
 /* Method table lookup (the registry lists every method once). */

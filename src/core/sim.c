@@ -3,6 +3,7 @@
  * 4). The loop calls method->stable_dt and method->step once per step. */
 #include "sph/sim.h"
 
+#include "sph/reference.h"
 #include "sph/tensor.h"
 
 #include <math.h>
@@ -51,6 +52,10 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                            scene->h_over_dp * sim->dp, err);
   }
   if (st == SPH_OK)
+    st = sph_reference_create(&sim->reference, scene, err);
+  if (st == SPH_OK && sim->reference)
+    st = sph_reference_initialise(sim->reference, sim, err);
+  if (st == SPH_OK)
     st = method->setup(sim, scene->method, err);
   if (st != SPH_OK) {
     sph_sim_destroy(sim);
@@ -69,6 +74,7 @@ void sph_sim_destroy(sph_sim *sim) {
   if (sim->method && sim->method->destroy)
     sim->method->destroy(sim);
   sph_particles_destroy(sim->ps);
+  sph_reference_destroy(sim->reference);
   free(sim);
 }
 

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "sph/reference.h"
 #include "sph/stability.h"
 
 static void json_string(FILE *f, const char *s) {
@@ -88,6 +89,17 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_string(f, v->reason);
   fputs(",\n  \"tripped_at\": ", f);
   json_number(f, v->stable ? NAN : v->t_tripped);
+  if (sim->reference) {
+    sph_reference_error e;
+    sph_reference_errors(sim->reference, sim, &e);
+    fputs(",\n  \"error\": {\"l2_velocity\": ", f);
+    json_number(f, e.l2_velocity);
+    fputs(", \"l2_stress\": ", f);
+    json_number(f, e.l2_stress);
+    fputs(", \"l2_displacement\": ", f);
+    json_number(f, e.l2_displacement);
+    fputs("}", f);
+  }
   fprintf(f, ",\n  \"threads\": %d,\n  \"t_end\": ", sim->threads);
   json_number(f, sim->scene->t_end);
   fputs(",\n  \"t_reached\": ", f);

@@ -124,7 +124,7 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, sph_error *err) {
   if (np) {
     double layer = 2.0 * sim->kernel.support, q = 1e-6 * sim->dp;
     hash h = {0};
-    h.cap = 16 * n + 1024;
+    h.cap = 16 * n > 65536 ? 16 * n : 65536;
     h.key = malloc(3 * h.cap * sizeof *h.key);
     h.used = calloc(h.cap, 1);
     if (!h.key || !h.used) {

@@ -545,12 +545,21 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
       return sph_node_error(sph_node_child(g, "body"), err, SPH_ERR_ARG,
                             "no body named '%s'", body);
   }
-  double spacing =
-      sel->body >= 0 ? s->bodies[sel->body].spacing : sph_scene_min_spacing(s);
+  /* the first particle layer: on the plane for face lattices, half a
+   * spacing inside for cell-centred ones (jitter moves it by < dp / 2) */
+  double spacing = INFINITY, tol = INFINITY;
+  for (size_t b = 0; b < s->nbodies; ++b) {
+    if (sel->body >= 0 && (int)b != sel->body)
+      continue;
+    const sph_body *bd = &s->bodies[b];
+    spacing = fmin(spacing, bd->spacing);
+    tol =
+        fmin(tol, (bd->lattice == SPH_LATTICE_FACES ? 0.5 : 1.0) * bd->spacing);
+  }
   if (sel->kind == SPH_SELECT_PLANE && sel->tolerance < 0.0) {
     char buf[40];
-    snprintf(buf, sizeof buf, "%.6g", 0.5 * spacing);
-    sel->tolerance = strtod(buf, NULL);
+    snprintf(buf, sizeof buf, "%.17g", tol);
+    sel->tolerance = tol;
     SPH_TRY(
         sph_node_insert_default(g, "tolerance", buf, &(sph_node *){0}, err));
   } else if (sel->kind != SPH_SELECT_PLANE) {

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "sph/reference.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
 
@@ -285,6 +286,44 @@ START_TEST(cable_against_dalembert) {
 }
 END_TEST
 
+/* B1 swinging cube with mirror planes: L2 errors of velocity and stress at
+ * t = T against eq. 52 at n = 8, 12, 16 particles per side */
+START_TEST(swinging_cube_converges) {
+  const int ns[3] = {8, 12, 16};
+  double ev[3], eP[3];
+  for (int i = 0; i < 3; ++i) {
+    char path[512], spacing[64];
+    snprintf(path, sizeof path, "%s/scenes/swinging_cube.yaml", SPH_SOURCE_DIR);
+    snprintf(spacing, sizeof spacing, "bodies.0.particles.spacing=%.17g",
+             1.0 / ns[i]);
+    const char *sets[] = {spacing};
+    sph_scene *s;
+    sph_sim *sim;
+    sph_error err;
+    ck_assert(sph_scene_load(&s, path, sets, 1, &err) == SPH_OK);
+    ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
+    ck_assert_ptr_nonnull(sim->reference);
+    run_to_end(sim);
+    sph_reference_error e;
+    sph_reference_errors(sim->reference, sim, &e);
+    ev[i] = e.l2_velocity;
+    eP[i] = e.l2_stress;
+    printf("B1 n = %2d: e_v %.4g  e_P %.4g  e_u %.4g\n", ns[i], ev[i], eP[i],
+           e.l2_displacement);
+    sph_sim_destroy(sim);
+    sph_scene_destroy(s);
+  }
+  for (int i = 0; i < 2; ++i) {
+    double r = log((double)ns[i + 1] / ns[i]);
+    double ov = log(ev[i] / ev[i + 1]) / r, oP = log(eP[i] / eP[i + 1]) / r;
+    printf("B1 order n %d -> %d: velocity %.2f, stress %.2f\n", ns[i],
+           ns[i + 1], ov, oP);
+    ck_assert_msg(ov >= 1.8, "velocity order %g", ov);
+    ck_assert_msg(oP >= 1.8, "stress order %g", oP);
+  }
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("tl_jst");
   TCase *tc = tcase_create("tl_jst");
@@ -297,6 +336,7 @@ int main(void) {
   tcase_add_test(tc, terms_follow_the_scene);
   tcase_add_test(tc, option_errors);
   tcase_add_test(tc, cable_against_dalembert);
+  tcase_add_test(tc, swinging_cube_converges);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }

@@ -295,6 +295,15 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   /* reference configuration (with mirror images) and the state */
   SPH_TRY(tl_reference_create(&m->ref, sim, err));
   size_t ne = m->ref.n_ext;
+  /* symmetry planes exert forces: the totals the projections zero are not
+   * zero there */
+  if (ne > n && (amp || jproj))
+    return sph_node_error(
+        sph_node_child(opt,
+                       amp ? "angular_momentum_projection" : "jst_projection"),
+        err, SPH_ERR_ARG,
+        "the momentum projections assume a free body; with symmetry planes "
+        "set angular_momentum_projection and jst_projection to false");
   m->x = m->ref.x;
   m->p = m->ref.p;
   m->F = m->ref.F;

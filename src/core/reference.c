@@ -1,0 +1,140 @@
+/* Analytic reference solutions (see include/sph/reference.h): the swinging
+ * cube of seed 000 sec. 8.2 eq. 52. */
+#include "sph/reference.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sph/tensor.h"
+
+struct sph_reference {
+  double U0, A[3];
+  double omega;        /* sqrt(3)/2 c_d pi */
+  double lambda, mu;   /* small strain moduli of the body */
+  double P_amp, v_amp; /* normalisations */
+};
+
+/* displacement gradient at unit amplitude: G_ij = A_i d f_i / d X_j */
+static void mode(const sph_reference *r, const double X[3], double f[3],
+                 double G[9]) {
+  double s[3], c[3], h = M_PI / 2;
+  for (int k = 0; k < 3; ++k) {
+    s[k] = sin(h * X[k]);
+    c[k] = cos(h * X[k]);
+  }
+  for (int i = 0; i < 3; ++i) {
+    double v = r->A[i];
+    for (int k = 0; k < 3; ++k)
+      v *= k == i ? s[k] : c[k];
+    f[i] = v;
+    for (int j = 0; j < 3; ++j) {
+      double d = r->A[i] * h;
+      for (int k = 0; k < 3; ++k)
+        d *= k == j ? (k == i ? c[k] : -s[k]) : (k == i ? s[k] : c[k]);
+      G[3 * i + j] = d;
+    }
+  }
+}
+
+/* small strain stress of a displacement gradient */
+static void stress(const sph_reference *r, const double G[9], double P[9]) {
+  double tr = G[0] + G[4] + G[8];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      P[3 * i + j] =
+          r->mu * (G[3 * i + j] + G[3 * j + i]) + (i == j) * r->lambda * tr;
+}
+
+sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
+                                sph_error *err) {
+  *out = NULL;
+  sph_node *n = s->reference;
+  if (!n)
+    return SPH_OK;
+  static const char *const keys[] = {"analytic", "U0", "A", "B", "C", NULL};
+  SPH_TRY(sph_node_check_keys(n, keys, err));
+  const char *kind;
+  SPH_TRY(sph_node_get_string(n, "analytic", 1, NULL, &kind, err));
+  if (strcmp(kind, "swinging_cube"))
+    return sph_node_error(sph_node_child(n, "analytic"), err, SPH_ERR_RANGE,
+                          "unknown reference '%s' (known: swinging_cube)",
+                          kind);
+  if (s->dimension != 3 || s->nbodies != 1)
+    return sph_node_error(n, err, SPH_ERR_ARG,
+                          "swinging_cube needs one body in 3D");
+  sph_reference *r = calloc(1, sizeof *r);
+  if (!r)
+    return sph_error_set(err, SPH_ERR_NOMEM, "reference");
+  sph_status st = sph_node_get_double(n, "U0", 0, 5e-4, &r->U0, err);
+  static const char *const amp[] = {"A", "B", "C"};
+  for (int i = 0; i < 3 && st == SPH_OK; ++i)
+    st = sph_node_get_double(n, amp[i], 0, 1.0, &r->A[i], err);
+  if (st != SPH_OK) {
+    free(r);
+    return st;
+  }
+  const sph_material *m = &s->materials[s->bodies[0].material];
+  r->lambda = m->lambda;
+  r->mu = m->mu;
+  r->omega = sqrt(3.0) / 2.0 * sph_material_wave_speed(m) * M_PI;
+  r->v_amp = r->U0 * r->omega *
+             fmax(fabs(r->A[0]), fmax(fabs(r->A[1]), fabs(r->A[2])));
+  *out = r;
+  return SPH_OK;
+}
+
+void sph_reference_destroy(sph_reference *r) { free(r); }
+
+sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
+                                    sph_error *err) {
+  sph_particles *ps = sim->ps;
+  SPH_TRY(sph_particles_require(ps, SPH_FIELD_DEFGRAD, err));
+  sph_reference *rw = (sph_reference *)r; /* amplitude found on the set */
+  rw->P_amp = 0.0;
+  for (size_t a = 0; a < ps->n; ++a) {
+    double f[3], G[9], P[9];
+    mode(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, f, G);
+    double *F = ps->field[SPH_FIELD_DEFGRAD] + 9 * a;
+    for (int k = 0; k < 9; ++k)
+      F[k] = (k % 4 == 0) + r->U0 * G[k];
+    for (int c = 0; c < 3; ++c)
+      ps->field[SPH_FIELD_VELOCITY][3 * a + c] = 0.0;
+    for (int k = 0; k < 9; ++k)
+      G[k] *= r->U0;
+    stress(r, G, P);
+    rw->P_amp = fmax(rw->P_amp, sqrt(sph_mat3_ddot(P, P)));
+  }
+  sim->initial_defgrad = 1;
+  return SPH_OK;
+}
+
+void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
+                          sph_reference_error *e) {
+  const sph_particles *ps = sim->ps;
+  double t = sim->t, cw = cos(r->omega * t), sw = sin(r->omega * t);
+  double sv = 0.0, ev = 0.0, eP = 0.0, eu = 0.0;
+  for (size_t a = 0; a < ps->n; ++a) {
+    double f[3], G[9], P[9];
+    const double V = ps->field[SPH_FIELD_VOLUME0][a];
+    mode(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, f, G);
+    for (int k = 0; k < 9; ++k)
+      G[k] *= r->U0 * cw;
+    stress(r, G, P);
+    const double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * a;
+    const double *u = ps->field[SPH_FIELD_DISPLACEMENT] + 3 * a;
+    const double *Pn = ps->field[SPH_FIELD_PK1] + 9 * a;
+    for (int i = 0; i < 3; ++i) {
+      double vex = -r->U0 * r->omega * sw * f[i];
+      double uex = r->U0 * (cw - 1.0) * f[i]; /* x - X = u(t) - u(0) */
+      ev += V * (v[i] - vex) * (v[i] - vex);
+      eu += V * (u[i] - uex) * (u[i] - uex);
+    }
+    for (int k = 0; k < 9; ++k)
+      eP += V * (Pn[k] - P[k]) * (Pn[k] - P[k]);
+    sv += V;
+  }
+  e->l2_velocity = sqrt(ev / sv) / r->v_amp;
+  e->l2_stress = sqrt(eP / sv) / r->P_amp;
+  e->l2_displacement = sqrt(eu / sv) / r->U0;
+}
