@@ -38,6 +38,8 @@ struct sph_sink {
 extern const sph_sink_ops sph_energy_sink_ops;
 /* probes.csv: the fields each probe asked for */
 extern const sph_sink_ops sph_probe_sink_ops;
+/* <scene>_NNNN.vtp per output time and <scene>.pvd (ParaView) */
+extern const sph_sink_ops sph_vtk_sink_ops;
 
 /* Files written under a temporary name, fsync'd and renamed on commit. */
 typedef struct sph_atomic_file {

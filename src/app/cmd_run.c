@@ -156,9 +156,11 @@ int sph_cmd_run(int argc, char **argv) {
   if (!args.quiet)
     banner(sim, dir);
 
-  sph_sink sinks[2];
+  sph_sink sinks[3];
   int nsinks = 0;
   sinks[nsinks++] = (sph_sink){.ops = &sph_energy_sink_ops};
+  if (scene->output.vtk)
+    sinks[nsinks++] = (sph_sink){.ops = &sph_vtk_sink_ops};
   if (scene->output.nprobes)
     sinks[nsinks++] = (sph_sink){.ops = &sph_probe_sink_ops};
   sph_verdict *verdict = NULL;

@@ -1,0 +1,140 @@
+#!/usr/bin/python3
+"""Reads what `sph run` wrote with VTK's own XML reader (python3-vtk9) and
+checks it: the .pvd is a Collection with increasing times and every file
+present; every .vtp reads without a VTK error or warning (each in its own
+process: a malformed header can abort the reader); point counts, array
+names and component counts; binary and ASCII runs hold identical values;
+points equal initial_position + displacement; the probe particle's values
+equal probes.csv. Usage: check_vtk.py BINARY_DIR ASCII_DIR SCENE_NAME"""
+import csv
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+EXPECTED = {"pressure": 1, "velocity": 3, "displacement": 3,
+            "initial_position": 3, "J": 1, "stress": 9, "body_id": 1,
+            "particle_id": 1}
+
+
+def read_one(path):
+    """Child process: read a file, print its arrays as repr() or fail."""
+    from vtkmodules.vtkCommonCore import vtkCommand
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    problems = []
+    reader = vtkXMLPolyDataReader()
+    for event in (vtkCommand.ErrorEvent, vtkCommand.WarningEvent):
+        reader.AddObserver(event, lambda obj, ev: problems.append(ev))
+        reader.GetExecutive().AddObserver(event,
+                                          lambda obj, ev: problems.append(ev))
+    reader.SetFileName(path)
+    reader.Update()
+    if problems:
+        sys.exit("VTK reported %s reading %s" % (problems, path))
+    poly = reader.GetOutput()
+
+    def values(a):  # no numpy in Debian's python3-vtk9 dependencies
+        nc = a.GetNumberOfComponents()
+        return [list(a.GetTuple(i)) if nc > 1 else a.GetTuple(i)[0]
+                for i in range(a.GetNumberOfTuples())]
+
+    out = {"npoints": poly.GetNumberOfPoints(),
+           "nverts": poly.GetNumberOfVerts(),
+           "points": values(poly.GetPoints().GetData())}
+    pd = poly.GetPointData()
+    for i in range(pd.GetNumberOfArrays()):
+        a = pd.GetArray(i)
+        out[a.GetName()] = (a.GetNumberOfComponents(), values(a))
+    print(repr(out))
+
+
+def read(path):
+    r = subprocess.run([sys.executable, __file__, "--one", path],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        fail("%s: %s %s" % (path, r.stdout[-500:], r.stderr[-2000:]))
+        return None
+    return eval(r.stdout)  # our own repr() of lists and numbers
+
+
+failures = 0
+
+
+def fail(msg):
+    global failures
+    failures += 1
+    print("FAIL:", msg)
+
+
+def frames(d, name):
+    root = ET.parse(os.path.join(d, name + ".pvd")).getroot()
+    if root.get("type") != "Collection":
+        fail("%s.pvd is not a Collection" % name)
+    sets = root.find("Collection").findall("DataSet")
+    times = [float(s.get("timestep")) for s in sets]
+    if any(b <= a for a, b in zip(times, times[1:])):
+        fail("pvd times do not increase: %s" % times)
+    files = [os.path.join(d, s.get("file")) for s in sets]
+    for f in files:
+        if not os.path.exists(f):
+            fail("pvd lists a missing file %s" % f)
+    return times, files
+
+
+def close(a, b, tol):
+    return abs(a - b) <= tol * max(1.0, abs(a), abs(b))
+
+
+def main():
+    bdir, adir, name = sys.argv[1:4]
+    tb, fb = frames(bdir, name)
+    ta, fa = frames(adir, name)
+    if tb != ta or len(fb) < 2:
+        fail("binary and ASCII runs list different frames")
+    probes = list(csv.DictReader(open(os.path.join(bdir, "probes.csv"))))
+    for k, (path_b, path_a) in enumerate(zip(fb, fa)):
+        b, a = read(path_b), read(path_a)
+        if b is None or a is None:
+            continue
+        n = b["npoints"]
+        if n != a["npoints"] or b["nverts"] != n:
+            fail("%s: %d points, %d verts" % (path_b, n, b["nverts"]))
+        for arr, nc in EXPECTED.items():
+            if arr not in b or b[arr][0] != nc:
+                fail("%s: array %s missing or not %d components" %
+                     (path_b, arr, nc))
+                continue
+            if b[arr][1] != a[arr][1]:
+                fail("%s: %s differs between binary and ASCII" % (path_b, arr))
+        if b["points"] != a["points"]:
+            fail("%s: points differ between binary and ASCII" % path_b)
+        # points = initial position + displacement
+        X, U = b["initial_position"][1], b["displacement"][1]
+        for p, x0, u in zip(b["points"], X, U):
+            if any(not close(p[c], x0[c] + u[c], 1e-12) for c in range(3)):
+                fail("%s: point %s != X + u" % (path_b, p))
+                break
+        # the probe particle: nearest to the probe in the reference state
+        row = probes[k]
+        if not close(float(row["time"]), tb[k], 1e-12):
+            fail("probe time %s vs frame time %s" % (row["time"], tb[k]))
+        at = (0.5, 6.0, 0.5)
+        i = min(range(n), key=lambda j: sum((X[j][c] - at[c]) ** 2
+                                            for c in range(3)))
+        for c, s in enumerate("xyz"):
+            for field in ("displacement", "velocity"):
+                want = float(row["tip.%s_%s" % (field, s)])
+                if not close(b[field][1][i][c], want, 1e-12):
+                    fail("%s: tip %s_%s %r vs probes.csv %r" %
+                         (path_b, field, s, b[field][1][i][c], want))
+    print("%d frames checked, %d problems" % (len(fb), failures))
+    print("%d passed, %d failed" % (1 if failures == 0 else 0,
+                                    1 if failures else 0))
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--one":
+        read_one(sys.argv[2])
+    else:
+        main()
