@@ -424,6 +424,54 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
   }
 }
 
+/* largest eigenvalue of a symmetric 3x3 matrix (trigonometric method) */
+static double sym3_max_eigenvalue(const double A[9]) {
+  double p1 = A[1] * A[1] + A[2] * A[2] + A[5] * A[5];
+  double q = (A[0] + A[4] + A[8]) / 3.0;
+  double p2 = (A[0] - q) * (A[0] - q) + (A[4] - q) * (A[4] - q) +
+              (A[8] - q) * (A[8] - q) + 2.0 * p1;
+  if (p2 <= 1e-30 * q * q)
+    return q;
+  double p = sqrt(p2 / 6.0), B[9];
+  for (int k = 0; k < 9; ++k)
+    B[k] = (A[k] - (k % 4 == 0) * q) / p;
+  double r = 0.5 * sph_mat3_det(B);
+  double phi = r <= -1.0 ? M_PI / 3.0 : (r >= 1.0 ? 0.0 : acos(r) / 3.0);
+  return q + 2.0 * p * cos(phi);
+}
+
+double tl_max_wave_speed(const tl_reference *ref, const double *F) {
+  long n = (long)ref->n;
+  double c2max = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : c2max)
+  for (long a = 0; a < n; ++a) {
+    const double *Fa = F + 9 * a;
+    const sph_material *m = ref->mat[a];
+    double H[9], P0[9];
+    sph_mat3_cofactor(Fa, H);
+    sph_material_stress(m, Fa, H, sph_mat3_det(Fa), P0);
+    double e = 1e-7 * sqrt(sph_mat3_ddot(Fa, Fa) / 3.0);
+    for (int d = 0; d < 3; ++d) {
+      double Q[9];
+      for (int k = 0; k < 3; ++k) {
+        double Fp[9], Hp[9], Pp[9];
+        memcpy(Fp, Fa, sizeof Fp);
+        Fp[3 * k + d] += e;
+        sph_mat3_cofactor(Fp, Hp);
+        sph_material_stress(m, Fp, Hp, sph_mat3_det(Fp), Pp);
+        for (int i = 0; i < 3; ++i)
+          Q[3 * i + k] = (Pp[3 * i + d] - P0[3 * i + d]) / e;
+      }
+      for (int i = 0; i < 3; ++i) /* symmetric part */
+        for (int k = i + 1; k < 3; ++k)
+          Q[3 * i + k] = Q[3 * k + i] = 0.5 * (Q[3 * i + k] + Q[3 * k + i]);
+      double c2 = sym3_max_eigenvalue(Q) / m->density;
+      c2max = c2 > c2max ? c2 : c2max;
+    }
+  }
+  return sqrt(c2max);
+}
+
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
                const double *J, double *kinetic, double *strain) {
   const double *V = ref->V, *p = ref->p, *F = ref->F;

@@ -58,6 +58,13 @@ void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
 void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
                const double *J);
 
+/* Largest p-wave speed of the current state (seed 000 eq. 44, "c_p from
+ * the current state"): for each particle the largest eigenvalue of the
+ * acoustic tensor Q_ik(N) = dP_iJ/dF_kL N_J N_L along the three material
+ * axes, with dP/dF by finite differences of the material's stress at
+ * (F, cof F, det F); at F = I it is the linear p-wave speed. */
+double tl_max_wave_speed(const tl_reference *ref, const double *F);
+
 /* Kinetic and strain energy of the real particles; H and J may be NULL. */
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
                const double *J, double *kinetic, double *strain);

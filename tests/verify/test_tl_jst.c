@@ -118,7 +118,9 @@ START_TEST(energy_is_second_order_without_dissipation) {
   /* no JST, no projection: the scheme is conservative in space and the
    * energy error comes from TVD-RK2, O(dt^2) */
   double d[2];
-  const char *cfl[2] = {"method.cfl=0.2", "method.cfl=0.1"};
+  /* asymptotic range: near the stability limit higher-order terms of the
+   * RK2 amplification error dominate (CFL 0.2 vs 0.1 gives a ratio ~ 1) */
+  const char *cfl[2] = {"method.cfl=0.025", "method.cfl=0.0125"};
   for (int i = 0; i < 2; ++i) {
     const char *sets[] = {"method.jst.eps4_p=0",
                           "method.angular_momentum_projection=false", cfl[i]};
@@ -126,14 +128,14 @@ START_TEST(energy_is_second_order_without_dissipation) {
     drifts(sets, 3, &lin, &ang, &e0, &e1);
     d[i] = fabs(e1 - e0) / e0;
   }
-  printf("energy drift without dissipation: %.3g (cfl 0.2), %.3g (cfl 0.1), "
-         "ratio %.2f\n",
+  printf("energy drift without dissipation: %.3g (cfl 0.025), %.3g (cfl "
+         "0.0125), ratio %.2f\n",
          d[0], d[1], d[0] / d[1]);
   ck_assert_msg(d[0] / d[1] > 3.0,
                 "energy drift ratio %g is not second "
                 "order",
                 d[0] / d[1]);
-  ck_assert(d[0] < 1e-2);
+  ck_assert(d[0] < 1e-4);
 }
 END_TEST
 

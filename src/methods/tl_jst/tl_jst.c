@@ -145,9 +145,14 @@ static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
  * ------------------------------------------------------------------------- */
 
 static double tl_jst_stable_dt(sph_sim *sim) {
-  const tl_jst *m = sim->method_data;
-  /* eq. 44 with h_min the particle spacing and the materials' c_p */
-  return m->cfl * sim->dp / m->ref.cp;
+  tl_jst *m = sim->method_data;
+  /* eq. 44 with h_min the particle spacing and c_p of the current state */
+  double c = m->ref.cp;
+  if (m->current_wave_speed) {
+    double cs = tl_max_wave_speed(&m->ref, m->F);
+    c = cs > c ? cs : c;
+  }
+  return m->cfl * sim->dp / c;
 }
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
@@ -227,17 +232,11 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
 }
 
 static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
-  static const char *const keys[] = {"name",
-                                     "fields",
-                                     "force",
-                                     "jst",
-                                     "jst_projection",
-                                     "angular_momentum_projection",
-                                     "laplacian",
-                                     "integrator",
-                                     "cfl",
-                                     "essential_bc",
-                                     NULL};
+  static const char *const keys[] = {
+      "name",         "fields",         "force",
+      "jst",          "jst_projection", "angular_momentum_projection",
+      "laplacian",    "integrator",     "cfl",
+      "essential_bc", "wave_speed",     NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   tl_jst *m = calloc(1, sizeof *m);
   if (!m)
@@ -261,6 +260,10 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(parse_choice(opt, "laplacian", laps, "corrected", &lp, err));
   SPH_TRY(parse_choice(opt, "integrator", integrators, "tvd-rk2", &integ, err));
   SPH_TRY(parse_choice(opt, "essential_bc", bcs, "direct", &bc, err));
+  static const char *const speeds[] = {"current", "reference", NULL};
+  int ws;
+  SPH_TRY(parse_choice(opt, "wave_speed", speeds, "current", &ws, err));
+  m->current_wave_speed = ws == 0;
   m->fields = (tl_jst_fields)f;
   m->force = (tl_jst_force)fo;
   SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));

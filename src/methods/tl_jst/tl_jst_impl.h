@@ -19,10 +19,11 @@ typedef struct tl_jst {
   tl_jst_fields fields;
   tl_jst_force force;
   double cfl;
-  tl_reference ref;   /* neighbours, gradients, materials */
-  double *lap;        /* Laplacian weight per slot (NULL if unused) */
-  double *fgrad;      /* force gradients per slot (eq. 30, 31 only) */
-  double *fgrad_self; /* eq. 31: grad W~1_a(X_a) per particle */
+  int current_wave_speed; /* dt from the current state's c_p */
+  tl_reference ref;       /* neighbours, gradients, materials */
+  double *lap;            /* Laplacian weight per slot (NULL if unused) */
+  double *fgrad;          /* force gradients per slot (eq. 30, 31 only) */
+  double *fgrad_self;     /* eq. 31: grad W~1_a(X_a) per particle */
   /* state (particle fields) and its RK copies and rates */
   double *x, *p, *F, *H, *J;
   double *x0, *p0, *F0, *H0, *J0;
