@@ -49,6 +49,13 @@ done
 "$sph" run --threads 0 2>/dev/null
 [ $? -eq 2 ] && ok || bad "bad --threads"
 
+# an output folder that cannot be created: clear error, nothing written
+touch "$work/plainfile"
+"$sph" run "$src/scenes/twisting_column.yaml" --out "$work/plainfile/out" --quiet >/dev/null 2>"$work/stderr"
+rc=$?
+[ $rc -ne 0 ] && grep -qF "$work/plainfile/out" "$work/stderr" && [ ! -e "$work/plainfile/out" ] && ok ||
+  bad "unwritable output (exit $rc): $(cat "$work/stderr")"
+
 # a tiny run end to end, then the overwrite guard
 tiny="$work/tiny.yaml"
 sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
@@ -57,6 +64,7 @@ sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
 rc=$?
 if [ $rc -eq 0 ] && [ -f "$work/run/summary.json" ] && [ -f "$work/run/energy.csv" ] &&
   [ -f "$work/run/probes.csv" ] && [ -f "$work/run/scene_used.yaml" ] &&
+  [ -f "$work/run/twisting_column.pvd" ] && [ -f "$work/run/twisting_column_0004.vtp" ] &&
   [ "$(wc -l <"$work/run/energy.csv")" -eq 6 ] && ! ls "$work/run"/*.part >/dev/null 2>&1; then
   ok
 else
