@@ -55,9 +55,10 @@ typedef struct sph_cloud {
 
 /* Per-pair gradients grad[3*k] for every slot k of the CSR list; if not
  * NULL, grad_self[3*a] receives the gradient of the particle's own kernel
- * at itself (nonzero only for W1, where sum_b V_b f_b grad W~1_b(x_a) over b
- * including a reproduces linear gradients), and L[9*a] the correction
- * matrices used (identity for UNCORRECTED and W1). */
+ * at itself (zero for UNCORRECTED and CORRECTED; nonzero for CORRECTED_W0
+ * and W1, where sum_b V_b f_b grad W~1_b(x_a) over b including a reproduces
+ * linear gradients), and L[9*a] the correction matrices used (identity for
+ * UNCORRECTED and W1). */
 sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
                                    double *grad, double *grad_self, double *L,
                                    sph_error *err);

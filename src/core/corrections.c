@@ -4,9 +4,13 @@
  * eq. 10-14), first-order corrected kernel W~1 and its exact gradient
  * (seed 004 eq. 6-8, App. A eq. A.1-A.6), and the corrected Laplacian of
  * seed 000 App. A (eq. A.2-A.5) with the quadratic condition sum V |r|^2
- * Lap W~ = 2d in d dimensions. */
+ * Lap W~ = 2d in d dimensions.
+ *
+ * The gradient of W~0 is the exact derivative of eq. 10,
+ * (grad W_b - W_b gamma) / S; eq. 13 as printed drops the factor W_b. */
 #include "sph/corrections.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -18,23 +22,42 @@ static double rcond_min(const sph_cloud *c) {
   return c->rcond_min > 0.0 ? c->rcond_min : RCOND_DEFAULT;
 }
 
-/* Inverts the dim x dim block of A (unused diagonal padded with the mean
- * used diagonal); returns the reciprocal 1-norm condition number (0 when
- * singular). The unused block of Ainv is the identity. */
-static double invert_block(const double A[9], int dim, double Ainv[9]) {
-  double P[9] = {0};
-  double diag = 0.0;
+/* 1-norm of the leading dim x dim block */
+static double block_norm1(const double A[9], int dim) {
+  double best = 0.0;
+  for (int j = 0; j < dim; ++j) {
+    double s = 0.0;
+    for (int i = 0; i < dim; ++i)
+      s += fabs(A[3 * i + j]);
+    best = s > best ? s : best;
+  }
+  return best;
+}
+
+/* Inverts the leading dim x dim block of A; the rest of Ainv is the
+ * identity. Returns the reciprocal 1-norm condition number of the block,
+ * computed from the adjugate so that nothing is divided by a vanishing
+ * determinant; Ainv is written only when the result is >= rmin. */
+static double invert_block(const double A[9], int dim, double rmin,
+                           double Ainv[9]) {
+  double P[9], H[9];
+  sph_mat3_identity(P);
   for (int i = 0; i < dim; ++i)
-    diag += fabs(A[4 * i]) / dim;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      P[3 * i + j] = (i < dim && j < dim) ? A[3 * i + j] : (i == j ? diag : 0);
-  if (!(diag > 0.0) || !isfinite(diag))
+    for (int j = 0; j < dim; ++j)
+      P[3 * i + j] = A[3 * i + j];
+  /* adj(P) = H^T; its leading block is the adjugate of A's block */
+  sph_mat3_cofactor(P, H);
+  double det = P[0] * H[0] + P[1] * H[1] + P[2] * H[2];
+  double adj[9];
+  sph_mat3_transpose(H, adj);
+  double denom = block_norm1(P, dim) * block_norm1(adj, dim);
+  if (det == 0.0 || !isfinite(det) || !(denom > 0.0) || !isfinite(denom))
     return 0.0;
-  double det = sph_mat3_inverse(P, Ainv);
-  if (det == 0.0 || !isfinite(det))
-    return 0.0;
-  double rc = 1.0 / (sph_mat3_norm1(P) * sph_mat3_norm1(Ainv));
+  double rc = fabs(det) / denom;
+  if (!(rc >= rmin))
+    return rc;
+  for (int k = 0; k < 9; ++k)
+    Ainv[k] = adj[k] / det;
   for (int i = dim; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       Ainv[3 * i + j] = Ainv[3 * j + i] = (i == j);
@@ -59,14 +82,24 @@ static sph_status singular(const sph_cloud *c, long a, const char *what,
                        what, id, x[0], x[1], x[2], nb);
 }
 
+/* Zeroes the slots of a particle whose correction failed. */
+static void clear_slots(const sph_neighbors *nl, size_t a, int stride,
+                        double *v) {
+  size_t lo = nl->offset[a], hi = nl->offset[a + 1];
+  if (hi > lo)
+    memset(v + (size_t)stride * lo, 0, (size_t)stride * (hi - lo) * sizeof *v);
+}
+
+/* rab = x_a - x_b in the first dim components (the rest are zero) */
 static inline void pair_vector(const sph_cloud *c, size_t a, size_t b,
                                double rab[3], double *r) {
   for (int k = 0; k < 3; ++k)
-    rab[k] = c->x[3 * a + k] - c->x[3 * b + k]; /* x_a - x_b */
+    rab[k] = k < c->dim ? c->x[3 * a + k] - c->x[3 * b + k] : 0.0;
   *r = sqrt(sph_vec3_dot(rab, rab));
 }
 
-/* Shepard sum S = sum_b V_b W_b(x_a) including a, and gamma of eq. 14 */
+/* Shepard sum S = sum_b V_b W_b(x_a) including a, and gamma = grad S / S
+ * (seed 004 eq. 14) */
 static void shepard(const sph_cloud *c, size_t a, double *S, double gam[3]) {
   const sph_neighbors *nl = c->nl;
   *S = c->volume[a] * sph_kernel_eval(c->kernel, 0.0);
@@ -84,20 +117,24 @@ static void shepard(const sph_cloud *c, size_t a, double *S, double gam[3]) {
     gam[i] /= *S;
 }
 
-/* First-order corrected kernel coefficients at a (seed 004 eq. A.2-A.3) and
- * their gradients (A.5-A.6). */
+/* First-order corrected kernel coefficients at a (seed 004 eq. 7-8, A.2-A.3)
+ * and their gradients (A.5-A.6), with the moments of the evaluation point x
+ *   phi = sum V W, vphi = sum V (x - x_b) W, Phi = sum V (x - x_b)(x) (x - x_b)
+ * W over b including a (which adds V_a W(0) to phi and V_a W(0) I to grad
+ * vphi).
+ */
 typedef struct w1_coef {
   double alpha, beta[3];
   double dalpha[3], dbeta[3][3]; /* dbeta[k][i] = d beta_i / d x_k */
 } w1_coef;
 
-static int w1_coefficients(const sph_cloud *c, size_t a, w1_coef *w) {
+static int w1_coefficients(const sph_cloud *c, size_t a, double rmin,
+                           w1_coef *w) {
   const sph_neighbors *nl = c->nl;
   int dim = c->dim;
   double W0 = sph_kernel_eval(c->kernel, 0.0) * c->volume[a];
   double phi = W0, vphi[3] = {0}, Phi[9] = {0};
   double dphi[3] = {0}, dvphi[3][3] = {{0}}, dPhi[3][9] = {{0}};
-  /* the self term contributes W(0) to phi and I W(0) to d vphi */
   for (int k = 0; k < dim; ++k)
     dvphi[k][k] += W0;
   for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
@@ -125,15 +162,19 @@ static int w1_coefficients(const sph_cloud *c, size_t a, w1_coef *w) {
     }
   }
   double Pinv[9];
-  if (invert_block(Phi, dim, Pinv) < rcond_min(c))
+  if (invert_block(Phi, dim, rmin, Pinv) < rmin)
     return -1;
   for (int i = dim; i < 3; ++i)
     Pinv[4 * i] = 0.0; /* unused directions carry no correction */
+  /* beta = -Phi^-1 vphi (eq. 7), alpha = 1 / (phi + beta . vphi) (eq. 8) */
   double t[3];
   sph_mat3_vec(Pinv, vphi, t);
   for (int i = 0; i < 3; ++i)
     w->beta[i] = -t[i];
-  w->alpha = 1.0 / (phi + sph_vec3_dot(w->beta, vphi));
+  double den = phi + sph_vec3_dot(w->beta, vphi);
+  if (!(fabs(den) > DBL_EPSILON * phi))
+    return -1;
+  w->alpha = 1.0 / den;
   for (int k = 0; k < 3; ++k) {
     if (k >= dim) {
       w->dalpha[k] = 0.0;
@@ -161,24 +202,26 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
   int dim = c->dim;
   long n = (long)c->n, bad = n;
   double rmin = rcond_min(c);
+  if ((int)kind < SPH_GRAD_UNCORRECTED || kind > SPH_GRAD_W1)
+    return sph_error_set(err, SPH_ERR_ARG, "unknown gradient kind %d",
+                         (int)kind);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double La[9], gam[3] = {0, 0, 0}, S = 1.0;
+    double La[9], gs[3] = {0, 0, 0};
     sph_mat3_identity(La);
-    if (grad_self)
-      grad_self[3 * a] = grad_self[3 * a + 1] = grad_self[3 * a + 2] = 0.0;
     if (kind == SPH_GRAD_W1) {
       w1_coef w;
-      if (w1_coefficients(c, (size_t)a, &w)) {
+      if (w1_coefficients(c, (size_t)a, rmin, &w)) {
         mark_bad(&bad, a);
+        clear_slots(nl, (size_t)a, 3, grad);
+        if (grad_self)
+          memset(grad_self + 3 * a, 0, 3 * sizeof *grad_self);
         continue;
       }
+      /* grad of alpha(x) (1 + beta(x).(x - x_b)) W(x - x_b) at x = x_a */
       double W0 = sph_kernel_eval(c->kernel, 0.0);
-      /* d/dx of alpha (1 + beta.(x - x_a)) W(x - x_a) at x = x_a */
-      if (grad_self)
-        for (int k = 0; k < 3; ++k)
-          grad_self[3 * a + k] =
-              (w.dalpha[k] + (k < dim ? w.alpha * w.beta[k] : 0.0)) * W0;
+      for (int k = 0; k < 3; ++k)
+        gs[k] = (w.dalpha[k] + w.alpha * w.beta[k]) * W0;
       for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
         double rab[3], r, g[3];
         pair_vector(c, (size_t)a, (size_t)nl->index[s], rab, &r);
@@ -186,41 +229,51 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
         sph_kernel_gradient(c->kernel, rab, r, g);
         double lin = 1.0 + sph_vec3_dot(w.beta, rab);
         for (int k = 0; k < 3; ++k)
-          grad[3 * s + k] = w.dalpha[k] * lin * Wb +
-                            w.alpha *
-                                (sph_vec3_dot(w.dbeta[k], rab) +
-                                 (k < dim ? w.beta[k] : 0.0)) *
-                                Wb +
-                            w.alpha * lin * g[k];
+          grad[3 * s + k] =
+              w.dalpha[k] * lin * Wb +
+              w.alpha * (sph_vec3_dot(w.dbeta[k], rab) + w.beta[k]) * Wb +
+              w.alpha * lin * g[k];
       }
     } else {
-      if (kind == SPH_GRAD_CORRECTED_W0)
+      /* raw or W~0 gradients and the moment M = sum V g (x) (x_b - x_a) */
+      double S = 1.0, gam[3] = {0, 0, 0}, M[9] = {0};
+      int w0 = kind == SPH_GRAD_CORRECTED_W0;
+      if (w0) {
         shepard(c, (size_t)a, &S, gam);
-      /* raw (or W~0) gradients and the moment M = sum V g (x) (x_b - x_a) */
-      double M[9] = {0};
+        /* W~0_a(x) = W(x - x_a) / S(x): at x_a only S varies */
+        for (int k = 0; k < 3; ++k)
+          gs[k] = -sph_kernel_eval(c->kernel, 0.0) * gam[k] / S;
+      }
       for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
         size_t b = (size_t)nl->index[s];
         double rab[3], r, g[3];
         pair_vector(c, (size_t)a, b, rab, &r);
         sph_kernel_gradient(c->kernel, rab, r, g);
-        for (int k = 0; k < 3; ++k) {
-          g[k] = (g[k] - gam[k]) / S;
-          grad[3 * s + k] = g[k];
+        if (w0) {
+          double Wb = sph_kernel_eval(c->kernel, r);
+          for (int k = 0; k < 3; ++k)
+            g[k] = (g[k] - Wb * gam[k]) / S;
         }
-        double mr[3] = {-rab[0], -rab[1], -rab[2]};
+        memcpy(grad + 3 * s, g, sizeof g);
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j)
-            M[3 * i + j] += c->volume[b] * g[i] * mr[j];
+            M[3 * i + j] -= c->volume[b] * g[i] * rab[j];
       }
       if (kind != SPH_GRAD_UNCORRECTED) {
-        if (invert_block(M, dim, La) < rmin) {
+        if (invert_block(M, dim, rmin, La) < rmin) {
           mark_bad(&bad, a);
+          clear_slots(nl, (size_t)a, 3, grad);
+          if (grad_self)
+            memset(grad_self + 3 * a, 0, 3 * sizeof *grad_self);
           continue;
         }
         for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s)
           sph_mat3_vec(La, grad + 3 * s, grad + 3 * s);
+        sph_mat3_vec(La, gs, gs);
       }
     }
+    if (grad_self)
+      memcpy(grad_self + 3 * a, gs, sizeof gs);
     if (L)
       memcpy(L + 9 * a, La, sizeof La);
   }
@@ -233,11 +286,10 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
                                  double *wself, sph_error *err) {
   const sph_neighbors *nl = c->nl;
   long n = (long)c->n, bad = n;
+  double rmin = rcond_min(c);
   if (order != 0 && order != 1)
     return sph_error_set(err, SPH_ERR_ARG,
-                         "kernel correction order %d is not "
-                         "0 or 1",
-                         order);
+                         "kernel correction order %d is not 0 or 1", order);
   double W0 = sph_kernel_eval(c->kernel, 0.0);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
@@ -248,8 +300,10 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
       alpha = 1.0 / S;
     } else {
       w1_coef co;
-      if (w1_coefficients(c, (size_t)a, &co)) {
+      if (w1_coefficients(c, (size_t)a, rmin, &co)) {
         mark_bad(&bad, a);
+        clear_slots(nl, (size_t)a, 1, w);
+        wself[a] = 0.0;
         continue;
       }
       alpha = co.alpha;
@@ -269,54 +323,80 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
 }
 
 /* Solves the m x m system A x = b (m <= 4) by Gaussian elimination with
- * partial pivoting after symmetric diagonal scaling; returns the ratio of
- * the smallest to the largest pivot (0 when singular). */
-static double solve_small(int m, double A[4][4], double b[4], double x[4]) {
-  double s[4];
-  for (int i = 0; i < m; ++i)
-    s[i] = A[i][i] > 0.0 ? 1.0 / sqrt(A[i][i]) : 1.0;
-  for (int i = 0; i < m; ++i) {
-    b[i] *= s[i];
-    for (int j = 0; j < m; ++j)
-      A[i][j] *= s[i] * s[j];
+ * partial pivoting, on the matrix S A S made dimensionless by the diagonal
+ * scaling s. Returns the reciprocal 1-norm condition number of S A S (from
+ * its explicit inverse); a pivot below DBL_EPSILON ||S A S|| counts as
+ * singular (0). x is written only when the result is >= rmin. */
+static double solve_small(int m, double A[4][4], double b[4], const double s[4],
+                          double rmin, double x[4]) {
+  double LU[4][4], inv[4][4];
+  int perm[4];
+  double anorm = 0.0;
+  for (int j = 0; j < m; ++j) {
+    double col = 0.0;
+    for (int i = 0; i < m; ++i) {
+      LU[i][j] = A[i][j] * s[i] * s[j];
+      col += fabs(LU[i][j]);
+    }
+    anorm = col > anorm ? col : anorm;
   }
-  double pmin = INFINITY, pmax = 0.0;
-  for (int col = 0; col < m; ++col) {
-    int piv = col;
-    for (int i = col + 1; i < m; ++i)
-      if (fabs(A[i][col]) > fabs(A[piv][col]))
+  if (!(anorm > 0.0) || !isfinite(anorm))
+    return 0.0;
+  for (int i = 0; i < m; ++i)
+    perm[i] = i;
+  /* factorise P A = L U in place */
+  for (int k = 0; k < m; ++k) {
+    int piv = k;
+    for (int i = k + 1; i < m; ++i)
+      if (fabs(LU[i][k]) > fabs(LU[piv][k]))
         piv = i;
-    if (piv != col) {
-      for (int j = 0; j < m; ++j) {
-        double t = A[col][j];
-        A[col][j] = A[piv][j];
-        A[piv][j] = t;
-      }
-      double t = b[col];
-      b[col] = b[piv];
-      b[piv] = t;
-    }
-    double p = fabs(A[col][col]);
-    pmin = p < pmin ? p : pmin;
-    pmax = p > pmax ? p : pmax;
-    if (p == 0.0)
+    if (!(fabs(LU[piv][k]) > DBL_EPSILON * anorm))
       return 0.0;
-    for (int i = col + 1; i < m; ++i) {
-      double f = A[i][col] / A[col][col];
-      for (int j = col; j < m; ++j)
-        A[i][j] -= f * A[col][j];
-      b[i] -= f * b[col];
+    if (piv != k) {
+      for (int j = 0; j < m; ++j) {
+        double t = LU[k][j];
+        LU[k][j] = LU[piv][j];
+        LU[piv][j] = t;
+      }
+      int t = perm[k];
+      perm[k] = perm[piv];
+      perm[piv] = t;
+    }
+    for (int i = k + 1; i < m; ++i) {
+      LU[i][k] /= LU[k][k];
+      for (int j = k + 1; j < m; ++j)
+        LU[i][j] -= LU[i][k] * LU[k][j];
     }
   }
-  for (int i = m - 1; i >= 0; --i) {
-    double t = b[i];
-    for (int j = i + 1; j < m; ++j)
-      t -= A[i][j] * x[j];
-    x[i] = t / A[i][i];
+  /* inverse column by column: solve L U x = P e_j */
+  double inorm = 0.0;
+  for (int j = 0; j < m; ++j) {
+    double y[4];
+    for (int i = 0; i < m; ++i) {
+      y[i] = perm[i] == j ? 1.0 : 0.0;
+      for (int l = 0; l < i; ++l)
+        y[i] -= LU[i][l] * y[l];
+    }
+    double col = 0.0;
+    for (int i = m - 1; i >= 0; --i) {
+      for (int l = i + 1; l < m; ++l)
+        y[i] -= LU[i][l] * inv[l][j];
+      inv[i][j] = y[i] / LU[i][i];
+      col += fabs(inv[i][j]);
+    }
+    inorm = col > inorm ? col : inorm;
   }
-  for (int i = 0; i < m; ++i)
-    x[i] *= s[i];
-  return pmax > 0.0 ? pmin / pmax : 0.0;
+  double rc = 1.0 / (anorm * inorm);
+  if (!(rc >= rmin))
+    return rc;
+  /* x = S inv S b */
+  for (int i = 0; i < m; ++i) {
+    double t = 0.0;
+    for (int j = 0; j < m; ++j)
+      t += inv[i][j] * s[j] * b[j];
+    x[i] = s[i] * t;
+  }
+  return rc;
 }
 
 sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
@@ -324,10 +404,10 @@ sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
   const sph_neighbors *nl = c->nl;
   int d = c->dim, m = d + 1;
   long n = (long)c->n, bad = n;
-  double rmin = rcond_min(c);
+  double rmin = rcond_min(c), h = c->kernel->h;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    /* system A.5 with r_ab = X_b - X_a */
+    /* system A.5 with r_ab = X_b - X_a and right-hand side 2d (A.4) */
     double A[4][4] = {{0}}, rhs[4] = {0}, sol[4] = {0};
     rhs[d] = 2.0 * d;
     for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
@@ -348,11 +428,15 @@ sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
       A[d][d] += V * r2 * r2;
       rhs[d] -= V * r2 * lw;
     }
-    /* pivot ratios are squared condition measures of the scaled system */
-    if (solve_small(m, A, rhs, sol) < sqrt(rmin)) {
+    /* lengths in units of h make the system dimensionless */
+    double sc[4] = {1.0 / h, 1.0 / h, 1.0 / h, 1.0 / h};
+    sc[d] = 1.0 / (h * h);
+    if (solve_small(m, A, rhs, sc, rmin, sol) < rmin) {
       mark_bad(&bad, a);
+      clear_slots(nl, (size_t)a, 1, lap);
       continue;
     }
+    /* Lap W~ = Lap W + alpha . r_ab + beta |r_ab|^2 (A.2) */
     for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
       double rab[3], r;
       pair_vector(c, (size_t)a, (size_t)nl->index[s], rab, &r);

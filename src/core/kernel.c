@@ -130,7 +130,7 @@ sph_status sph_kernel_create(sph_kernel *k, sph_kernel_type type, int dim,
   if (dim < 1 || dim > 3)
     return sph_error_set(err, SPH_ERR_ARG, "dimension %d is not 1, 2 or 3",
                          dim);
-  if (!(h > 0.0) || !isfinite(h))
+  if (!isfinite(h) || !(h > 0.0))
     return sph_error_set(err, SPH_ERR_ARG,
                          "smoothing length %g is not "
                          "positive",
