@@ -472,6 +472,25 @@ double tl_max_wave_speed(const tl_reference *ref, const double *F) {
   return sqrt(c2max);
 }
 
+double tl_stable_dt(const tl_reference *ref, const sph_sim *sim, double cfl,
+                    int current) {
+  double c = ref->cp;
+  if (current) {
+    double cs = tl_max_wave_speed(ref, ref->F);
+    c = cs > c ? cs : c;
+  }
+  return cfl * sim->dp / c;
+}
+
+sph_status tl_check_finite(const tl_reference *ref, sph_error *err) {
+  long n3 = 3 * (long)ref->n;
+  for (long i = 0; i < n3; ++i)
+    if (!isfinite(ref->p[i]) || !isfinite(ref->x[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "nan: non-finite state at particle %ld", i / 3);
+  return SPH_OK;
+}
+
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
                const double *J, double *kinetic, double *strain) {
   const double *V = ref->V, *p = ref->p, *F = ref->F;

@@ -65,6 +65,15 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
  * (F, cof F, det F); at F = I it is the linear p-wave speed. */
 double tl_max_wave_speed(const tl_reference *ref, const double *F);
 
+/* Time step of seed 000 eq. 44: cfl h_min / c_p with c_p the larger of the
+ * materials' linear speed and (if `current`) tl_max_wave_speed. */
+double tl_stable_dt(const tl_reference *ref, const sph_sim *sim, double cfl,
+                    int current);
+
+/* SPH_ERR_NUMERIC naming the first particle whose position or momentum is
+ * not finite. */
+sph_status tl_check_finite(const tl_reference *ref, sph_error *err);
+
 /* Kinetic and strain energy of the real particles; H and J may be NULL. */
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
                const double *J, double *kinetic, double *strain);

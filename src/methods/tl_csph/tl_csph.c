@@ -76,18 +76,13 @@ static sph_status tl_csph_constrain(void *ctx, double t, sph_error *err) {
 
 static double tl_csph_stable_dt(sph_sim *sim) {
   const tl_csph *m = sim->method_data;
-  return m->cfl * sim->dp / m->ref.cp;
+  return tl_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
 }
 
 static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
   tl_csph *m = sim->method_data;
   SPH_TRY(sph_leapfrog_step(&m->lf, sim->t, dt, err));
-  long n3 = 3 * (long)sim->ps->n;
-  for (long i = 0; i < n3; ++i)
-    if (!isfinite(m->p[i]) || !isfinite(m->x[i]))
-      return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "nan: non-finite state at particle %ld", i / 3);
-  return SPH_OK;
+  return tl_check_finite(&m->ref, err);
 }
 
 static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
@@ -113,7 +108,8 @@ static void tl_csph_destroy(sph_sim *sim) {
 }
 
 static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
-  static const char *const keys[] = {"name", "cfl", "integrator", NULL};
+  static const char *const keys[] = {"name", "cfl", "integrator", "wave_speed",
+                                     NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   tl_csph *m = calloc(1, sizeof *m);
   if (!m)
@@ -124,6 +120,12 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (!(m->cfl > 0.0 && m->cfl <= 1.0))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
                           "cfl must be in (0, 1], got %g", m->cfl);
+  const char *ws;
+  SPH_TRY(sph_node_get_string(opt, "wave_speed", 0, "current", &ws, err));
+  if (strcmp(ws, "current") && strcmp(ws, "reference"))
+    return sph_node_error(sph_node_child(opt, "wave_speed"), err, SPH_ERR_RANGE,
+                          "'%s' is not one of: current, reference", ws);
+  m->current_wave_speed = !strcmp(ws, "current");
   const char *integ;
   SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
   if (strcmp(integ, "leapfrog"))

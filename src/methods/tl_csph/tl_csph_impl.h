@@ -8,8 +8,9 @@
 typedef struct tl_csph {
   tl_reference ref;
   double cfl;
-  double *x, *p, *F, *P; /* particle fields */
-  double *dp;            /* rate of momentum */
+  int current_wave_speed; /* dt from the current state's c_p */
+  double *x, *p, *F, *P;  /* particle fields */
+  double *dp;             /* rate of momentum */
   sph_leapfrog lf;
   int timer_force;
   struct sph_sim *sim;

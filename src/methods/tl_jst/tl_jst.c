@@ -146,24 +146,13 @@ static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
 
 static double tl_jst_stable_dt(sph_sim *sim) {
   tl_jst *m = sim->method_data;
-  /* eq. 44 with h_min the particle spacing and c_p of the current state */
-  double c = m->ref.cp;
-  if (m->current_wave_speed) {
-    double cs = tl_max_wave_speed(&m->ref, m->F);
-    c = cs > c ? cs : c;
-  }
-  return m->cfl * sim->dp / c;
+  return tl_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
 }
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
   SPH_TRY(sph_tvd_rk2_step(&m->ode, sim->t, dt, err));
-  long n3 = 3 * (long)sim->ps->n;
-  for (long i = 0; i < n3; ++i)
-    if (!isfinite(m->p[i]) || !isfinite(m->x[i]))
-      return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "nan: non-finite state at particle %ld", i / 3);
-  return SPH_OK;
+  return tl_check_finite(&m->ref, err);
 }
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
