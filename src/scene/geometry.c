@@ -1,9 +1,16 @@
 /* Geometry: signed distance functions of the scene shapes, their bounds and
- * exact measures, and the particle sets that fill them (a box lattice with
- * particles on the faces and tributary volumes, BENCHMARKS.md D.5; a
- * cell-centred lattice clipped to any shape; seeded jitter; a relaxation to
- * a uniform irregular set by kernel-gradient particle shifting, in the
- * spirit of the level-set relaxation of seed 002 sec. 6). */
+ * exact measures, and the particle sets that fill them:
+ *   - a box lattice with particles on the faces and tributary volumes
+ *     (BENCHMARKS.md D.5: sum V = body volume);
+ *   - a cell-centred lattice, tiling a box exactly, clipped to other shapes;
+ *   - seeded uniform jitter (splitmix64);
+ *   - a relaxation to the uniform, irregular distributions of seed 002
+ *     sec. 6.3-6.4 (there made by level-set pre-processing, its ref. [55]):
+ *     particles shift down the gradient of the kernel sum C = sum_b V W_ab
+ *     (particle shifting in the manner of Lind et al. 2012, without flow),
+ *     with the kernel support cut by a face replaced by the plane integral
+ *     of W (exact for a plane, since grad C over a half-space is the
+ *     integral of W over its boundary), and kept dp/2 inside the faces. */
 #include "sph/geometry.h"
 
 #include <math.h>
@@ -20,14 +27,14 @@ static double hypot3(double a, double b, double c) {
   return sqrt(a * a + b * b + c * c);
 }
 
-/* distance combining a radial and an axial slab (cylinder, tube) */
+/* exact distance of the intersection of a radial and an axial slab */
 static double combine(double dr, double da) {
   double ox = dr > 0 ? dr : 0, oy = da > 0 ? da : 0;
   double inside = dr > da ? dr : da;
   return sqrt(ox * ox + oy * oy) + (inside < 0 ? inside : 0);
 }
 
-/* radial distance from the axis and axial coordinate from the base */
+/* distance from the axis and coordinate along it from the base centre */
 static void axial_coords(const sph_shape *s, const double X[3], double *rho,
                          double *along) {
   double d[3] = {X[0] - s->center[0], X[1] - s->center[1], X[2] - s->center[2]};
@@ -36,27 +43,30 @@ static void axial_coords(const sph_shape *s, const double X[3], double *rho,
   *rho = hypot3(d[0], d[1], d[2]);
 }
 
+static int shape_is_axial(const sph_shape *s, int dim) {
+  return s->kind == SPH_SHAPE_CYLINDER ||
+         (s->kind == SPH_SHAPE_RING && dim == 3);
+}
+
 double sph_shape_distance(const sph_shape *s, int dim, const double X[3]) {
+  double dz = dim == 3 ? X[2] - s->center[2] : 0.0;
   switch (s->kind) {
   case SPH_SHAPE_BOX: {
-    double q[3] = {0, 0, 0}, outside = 0.0, inside = -INFINITY;
+    double outside = 0.0, inside = -INFINITY;
     for (int c = 0; c < dim; ++c) {
-      double mid = 0.5 * (s->min[c] + s->max[c]);
-      double half = 0.5 * (s->max[c] - s->min[c]);
-      q[c] = fabs(X[c] - mid) - half;
-      outside += q[c] > 0 ? q[c] * q[c] : 0.0;
-      inside = q[c] > inside ? q[c] : inside;
+      double q = fabs(X[c] - 0.5 * (s->min[c] + s->max[c])) -
+                 0.5 * (s->max[c] - s->min[c]);
+      outside += q > 0 ? q * q : 0.0;
+      inside = q > inside ? q : inside;
     }
     return sqrt(outside) + (inside < 0 ? inside : 0);
   }
   case SPH_SHAPE_DISC:
-  case SPH_SHAPE_SPHERE: {
-    double z = dim == 3 ? X[2] - s->center[2] : 0.0;
-    return hypot3(X[0] - s->center[0], X[1] - s->center[1], z) - s->radius;
-  }
+    return hypot3(X[0] - s->center[0], X[1] - s->center[1], 0.0) - s->radius;
+  case SPH_SHAPE_SPHERE:
+    return hypot3(X[0] - s->center[0], X[1] - s->center[1], dz) - s->radius;
   case SPH_SHAPE_SHELL: {
-    double r = hypot3(X[0] - s->center[0], X[1] - s->center[1],
-                      dim == 3 ? X[2] - s->center[2] : 0.0);
+    double r = hypot3(X[0] - s->center[0], X[1] - s->center[1], dz);
     return fmax(r - s->outer_radius, s->inner_radius - r);
   }
   case SPH_SHAPE_RING:
@@ -96,9 +106,7 @@ void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]) {
     lo[c] = s->center[c] - r;
     hi[c] = s->center[c] + r;
   }
-  int axial =
-      s->kind == SPH_SHAPE_CYLINDER || (s->kind == SPH_SHAPE_RING && dim == 3);
-  if (axial) {
+  if (shape_is_axial(s, dim)) {
     lo[s->axis] = s->center[s->axis];
     hi[s->axis] = s->center[s->axis] + s->length;
   }
@@ -115,10 +123,11 @@ double sph_shape_measure(const sph_shape *s, int dim) {
   case SPH_SHAPE_DISC:
     return M_PI * s->radius * s->radius;
   case SPH_SHAPE_SPHERE:
-    return 4.0 / 3.0 * M_PI * pow(s->radius, 3);
+    return 4.0 / 3.0 * M_PI * s->radius * s->radius * s->radius;
   case SPH_SHAPE_SHELL:
     return 4.0 / 3.0 * M_PI *
-           (pow(s->outer_radius, 3) - pow(s->inner_radius, 3));
+           (s->outer_radius * s->outer_radius * s->outer_radius -
+            s->inner_radius * s->inner_radius * s->inner_radius);
   case SPH_SHAPE_RING: {
     double a = M_PI * (s->outer_radius * s->outer_radius -
                        s->inner_radius * s->inner_radius);
@@ -130,8 +139,77 @@ double sph_shape_measure(const sph_shape *s, int dim) {
   return 0.0;
 }
 
-/* ---- random numbers (splitmix64) ------------------------------------------
- */
+/* ---- walls: the shape's faces near a point, as planes -------------------- */
+
+typedef struct wall {
+  double d;    /* signed distance to the face (negative inside) */
+  double n[3]; /* outward unit normal */
+} wall;
+
+/* radial face of a disc, sphere, shell or tube; sign -1 for an inner face */
+static int radial_wall(const double rel[3], double r, double radius, int sign,
+                       wall *w) {
+  if (!(r > 0.0))
+    return 0; /* on the centre: the normal is undefined and the face far */
+  w->d = sign * (r - radius);
+  for (int c = 0; c < 3; ++c)
+    w->n[c] = sign * rel[c] / r;
+  return 1;
+}
+
+static int axial_wall(int axis, double d, int sign, wall *w) {
+  w->d = d;
+  w->n[0] = w->n[1] = w->n[2] = 0.0;
+  w->n[axis] = sign;
+  return 1;
+}
+
+/* Fills up to 6 faces of the shape as seen from X; returns their number. */
+static int shape_walls(const sph_shape *s, int dim, const double X[3],
+                       wall w[6]) {
+  int k = 0;
+  double rel[3] = {X[0] - s->center[0], X[1] - s->center[1],
+                   dim == 3 ? X[2] - s->center[2] : 0.0};
+  switch (s->kind) {
+  case SPH_SHAPE_BOX:
+    for (int c = 0; c < dim; ++c) {
+      k += axial_wall(c, s->min[c] - X[c], -1, &w[k]);
+      k += axial_wall(c, X[c] - s->max[c], +1, &w[k]);
+    }
+    return k;
+  case SPH_SHAPE_DISC:
+  case SPH_SHAPE_SPHERE:
+  case SPH_SHAPE_SHELL:
+  case SPH_SHAPE_RING:
+  case SPH_SHAPE_CYLINDER: {
+    int axial = shape_is_axial(s, dim);
+    double along = 0.0;
+    if (axial) {
+      along = rel[s->axis];
+      rel[s->axis] = 0.0;
+    }
+    if (s->kind == SPH_SHAPE_DISC)
+      rel[2] = 0.0;
+    double r = hypot3(rel[0], rel[1], rel[2]);
+    if (s->kind == SPH_SHAPE_DISC || s->kind == SPH_SHAPE_SPHERE ||
+        s->kind == SPH_SHAPE_CYLINDER) {
+      k += radial_wall(rel, r, s->radius, +1, &w[k]);
+    } else {
+      k += radial_wall(rel, r, s->outer_radius, +1, &w[k]);
+      if (s->inner_radius > 0.0)
+        k += radial_wall(rel, r, s->inner_radius, -1, &w[k]);
+    }
+    if (axial) {
+      k += axial_wall(s->axis, -along, -1, &w[k]);
+      k += axial_wall(s->axis, along - s->length, +1, &w[k]);
+    }
+    return k;
+  }
+  }
+  return 0;
+}
+
+/* ---- random numbers: splitmix64 ------------------------------------------ */
 
 static uint64_t rng_next(uint64_t *state) {
   uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
@@ -140,16 +218,17 @@ static uint64_t rng_next(uint64_t *state) {
   return z ^ (z >> 31);
 }
 
-static double rng_uniform(uint64_t *state) { /* [-1, 1) */
+/* uniform in [-1, 1) */
+static double rng_uniform(uint64_t *state) {
   return 2.0 * ((double)(rng_next(state) >> 11) * 0x1.0p-53) - 1.0;
 }
 
-/* ---- lattices -------------------------------------------------------------
- */
+/* ---- lattices ------------------------------------------------------------ */
 
 typedef struct pointset {
   double *x, *v;
   size_t n, cap;
+  double h[3]; /* lattice spacing per axis */
 } pointset;
 
 static int push(pointset *p, const double X[3], double volume) {
@@ -170,207 +249,344 @@ static int push(pointset *p, const double X[3], double volume) {
   return 0;
 }
 
-static int lattice_faces(const sph_body *b, int dim, pointset *p) {
+/* more lattice points than this is a mistake in the scene */
+#define LATTICE_MAX 2147483647.0
+
+static sph_status lattice_faces(const sph_body *b, int dim, pointset *p,
+                                sph_error *err) {
   const sph_shape *s = &b->shape;
   int n[3] = {1, 1, 1};
-  double h[3] = {1, 1, 1};
+  double total = 1.0;
   for (int c = 0; c < dim; ++c) {
     n[c] = b->count[c];
-    h[c] = (s->max[c] - s->min[c]) / (n[c] - 1);
+    p->h[c] = (s->max[c] - s->min[c]) / (n[c] - 1);
+    total *= n[c];
   }
+  if (total > LATTICE_MAX)
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': %.3g particles are too many", b->name,
+                         total);
   for (int i = 0; i < n[0]; ++i)
     for (int j = 0; j < n[1]; ++j)
       for (int k = 0; k < n[2]; ++k) {
         int idx[3] = {i, j, k};
         double X[3] = {0, 0, 0}, vol = 1.0;
         for (int c = 0; c < dim; ++c) {
-          /* the last point is placed exactly on the max face */
-          X[c] = idx[c] == n[c] - 1 ? s->max[c] : s->min[c] + idx[c] * h[c];
-          vol *= (idx[c] == 0 || idx[c] == n[c] - 1) ? 0.5 * h[c] : h[c];
+          /* the last layer sits exactly on the max face */
+          X[c] = idx[c] == n[c] - 1 ? s->max[c] : s->min[c] + idx[c] * p->h[c];
+          vol *= (idx[c] == 0 || idx[c] == n[c] - 1) ? 0.5 * p->h[c] : p->h[c];
         }
         if (push(p, X, vol))
-          return -1;
+          return sph_error_set(err, SPH_ERR_NOMEM, "particles of body '%s'",
+                               b->name);
       }
-  return 0;
+  return SPH_OK;
 }
 
-static int lattice_cells(const sph_body *b, int dim, pointset *p) {
+static sph_status lattice_cells(const sph_body *b, int dim, pointset *p,
+                                sph_error *err) {
   const sph_shape *s = &b->shape;
-  double lo[3], hi[3], h[3] = {1, 1, 1};
+  int box = s->kind == SPH_SHAPE_BOX;
+  double lo[3], hi[3], total = 1.0;
   long n[3] = {1, 1, 1};
   sph_shape_bounds(s, dim, lo, hi);
   for (int c = 0; c < dim; ++c) {
-    double len = hi[c] - lo[c];
-    n[c] = (long)floor(len / b->spacing + 0.5);
-    if (n[c] < 1)
-      n[c] = 1;
-    /* boxes tile exactly; curved shapes keep the given spacing */
-    h[c] = s->kind == SPH_SHAPE_BOX ? len / (double)n[c] : b->spacing;
-    if (s->kind != SPH_SHAPE_BOX)
-      n[c] = (long)ceil(len / b->spacing) + 1;
+    double len = hi[c] - lo[c], cells = len / b->spacing;
+    if (cells > LATTICE_MAX)
+      cells = LATTICE_MAX + 1.0;
+    /* boxes are tiled exactly by n cells; other shapes keep dp */
+    n[c] = box ? (long)floor(cells + 0.5) : (long)ceil(cells) + 1;
+    p->h[c] = box && n[c] > 0 ? len / (double)n[c] : b->spacing;
+    total *= (double)n[c];
   }
+  if (total > LATTICE_MAX)
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': spacing %g gives %.3g lattice points, too "
+                         "many",
+                         b->name, b->spacing, total);
   double vol = 1.0;
   for (int c = 0; c < dim; ++c)
-    vol *= h[c];
+    vol *= p->h[c];
   for (long i = 0; i < n[0]; ++i)
     for (long j = 0; j < n[1]; ++j)
       for (long k = 0; k < n[2]; ++k) {
         long idx[3] = {i, j, k};
         double X[3] = {0, 0, 0};
         for (int c = 0; c < dim; ++c)
-          X[c] = lo[c] + (idx[c] + 0.5) * h[c];
-        if (s->kind != SPH_SHAPE_BOX && sph_shape_distance(s, dim, X) >= 0.0)
+          X[c] = lo[c] + ((double)idx[c] + 0.5) * p->h[c];
+        if (!box && !(sph_shape_distance(s, dim, X) < 0.0))
           continue;
         if (push(p, X, vol))
-          return -1;
+          return sph_error_set(err, SPH_ERR_NOMEM, "particles of body '%s'",
+                               b->name);
       }
-  return 0;
+  return SPH_OK;
 }
 
+/* ---- jitter -------------------------------------------------------------- */
+
 static void jitter(const sph_body *b, int dim, pointset *p) {
-  uint64_t state = (uint64_t)b->seed * 0x2545f4914f6cdd1dull + 1u;
-  double amp = b->jitter * b->spacing;
+  const sph_shape *s = &b->shape;
+  int faces = b->lattice == SPH_LATTICE_FACES;
+  uint64_t state = (uint64_t)b->seed;
   for (size_t i = 0; i < p->n; ++i) {
-    double X[3] = {p->x[3 * i], p->x[3 * i + 1], p->x[3 * i + 2]};
-    for (int c = 0; c < dim; ++c)
-      X[c] += amp * rng_uniform(&state);
+    double *X = p->x + 3 * i, Y[3] = {X[0], X[1], X[2]};
+    int inside = 1;
+    for (int c = 0; c < dim; ++c) {
+      double u = rng_uniform(&state); /* drawn always: one stream per seed */
+      /* face particles stay on their faces */
+      if (faces && (X[c] == s->min[c] || X[c] == s->max[c]))
+        continue;
+      Y[c] += b->jitter * p->h[c] * u;
+      inside = inside && (!faces || (Y[c] > s->min[c] && Y[c] < s->max[c]));
+    }
     /* a particle that would leave the shape keeps its lattice place */
-    if (sph_shape_distance(&b->shape, dim, X) < 0.0)
-      memcpy(p->x + 3 * i, X, sizeof X);
+    if (faces ? inside : sph_shape_distance(s, dim, Y) < 0.0)
+      memcpy(X, Y, sizeof Y);
   }
 }
 
-/* pulls X inside to distance -margin along the numerical SDF gradient */
-static void project_inside(const sph_shape *s, int dim, double X[3],
-                           double margin, double eps) {
-  for (int iter = 0; iter < 4; ++iter) {
-    double d = sph_shape_distance(s, dim, X);
-    if (d <= -margin)
-      return;
-    double g[3] = {0, 0, 0}, g2 = 0.0;
-    for (int c = 0; c < dim; ++c) {
-      double Xp[3] = {X[0], X[1], X[2]}, Xm[3] = {X[0], X[1], X[2]};
-      Xp[c] += eps;
-      Xm[c] -= eps;
-      g[c] = (sph_shape_distance(s, dim, Xp) - sph_shape_distance(s, dim, Xm)) /
-             (2 * eps);
-      g2 += g[c] * g[c];
+/* ---- relaxation ---------------------------------------------------------- */
+
+#define WALL_TABLE 256
+
+/* P(s): integral of W over a plane at distance s from its centre, i.e. the
+ * kernel gradient integrated over the half-space beyond a wall. Tabulated on
+ * [0, support] by Simpson's rule. */
+static void wall_table(const sph_kernel *k, int dim, double *P) {
+  const int m = 400; /* Simpson intervals, even */
+  for (int i = 0; i <= WALL_TABLE; ++i) {
+    double s = k->support * i / WALL_TABLE, sum = 0.0;
+    double top = sqrt(fmax(k->support * k->support - s * s, 0.0));
+    for (int j = 0; j <= m; ++j) {
+      double t = top * j / m,
+             w = (j == 0 || j == m) ? 1.0 : (j % 2 ? 4.0 : 2.0);
+      /* 2D: line integral over t; 3D: 2 pi rho drho over the plane */
+      double r = sqrt(s * s + t * t);
+      sum += w * sph_kernel_eval(k, r) * (dim == 2 ? 2.0 : 2.0 * M_PI * t);
     }
-    if (g2 <= 0.0)
-      return;
-    for (int c = 0; c < dim; ++c)
-      X[c] -= (d + margin) * g[c] / g2;
+    P[i] = sum * top / (3.0 * m);
+  }
+}
+
+static double wall_lookup(const double *P, double support, double s) {
+  double u = (s < 0 ? 0 : s) / support * WALL_TABLE;
+  if (u >= WALL_TABLE)
+    return 0.0;
+  int i = (int)u;
+  double f = u - i;
+  return (1.0 - f) * P[i] + f * P[i + 1];
+}
+
+/* Moves X to `margin` inside every face that is closer than that. */
+static void wall_project(const sph_shape *s, int dim, double X[3],
+                         double margin) {
+  for (int pass = 0; pass < 2; ++pass) {
+    wall w[6];
+    int nw = shape_walls(s, dim, X, w);
+    for (int i = 0; i < nw; ++i)
+      if (w[i].d > -margin) {
+        for (int c = 0; c < dim; ++c)
+          X[c] -= (w[i].d + margin) * w[i].n[c];
+        nw = shape_walls(s, dim, X, w);
+      }
   }
 }
 
 static sph_status relax(const sph_body *b, int dim, pointset *p,
                         sph_error *err) {
-  double dp = b->spacing;
+  if (b->relax_steps <= 0)
+    return SPH_OK;
+  const sph_shape *s = &b->shape;
+  /* the spacing of equal volumes that fill the shape */
+  double vol = sph_shape_measure(s, dim) / (double)p->n;
+  double dp = pow(vol, 1.0 / dim);
   sph_kernel k;
-  sph_status st =
-      sph_kernel_create(&k, SPH_KERNEL_WENDLAND_C2, dim, 1.3 * dp, err);
+  SPH_TRY(sph_kernel_create(&k, SPH_KERNEL_WENDLAND_C2, dim, 1.3 * dp, err));
+  double P[WALL_TABLE + 1];
+  wall_table(&k, dim, P);
   sph_neighbors *nl = NULL;
-  double *shift = NULL;
-  if (st == SPH_OK)
-    st = sph_neighbors_create(&nl, err);
-  if (st == SPH_OK && !(shift = calloc(3 * p->n, sizeof *shift)))
+  double *shift = NULL, *built = NULL;
+  sph_status st = sph_neighbors_create(&nl, err);
+  if (st == SPH_OK && (!(shift = calloc(3 * p->n, sizeof *shift)) ||
+                       !(built = malloc(3 * p->n * sizeof *built))))
     st = sph_error_set(err, SPH_ERR_NOMEM, "relaxation of body '%s'", b->name);
-  double vol = pow(dp, dim), diff = 0.5 * k.h * k.h, cap = 0.2 * dp;
+  /* shift = -D grad C with D = h^2 / 2, at most 0.2 dp per iteration */
+  const double diff = 0.5 * k.h * k.h, cap = 0.2 * dp;
+  /* Verlet lists: rebuilt once a particle may have moved skin / 2 */
+  const double skin = 0.6 * dp, reach2 = k.support * k.support;
+  double moved = INFINITY;
   for (int it = 0; st == SPH_OK && it < b->relax_steps; ++it) {
-    st = sph_neighbors_build(nl, p->x, p->n, dim, k.support, NULL,
-                             SPH_PAIRS_ALL, err);
-    if (st != SPH_OK)
-      break;
+    if (moved > 0.5 * skin) {
+      st = sph_neighbors_build(nl, p->x, p->n, dim, k.support + skin, NULL,
+                               SPH_PAIRS_ALL, err);
+      if (st != SPH_OK)
+        break;
+      memcpy(built, p->x, 3 * p->n * sizeof *built);
+      moved = 0.0;
+    }
     long n = (long)p->n;
-    /* shift down the gradient of the particle concentration */
 #pragma omp parallel for schedule(static)
     for (long a = 0; a < n; ++a) {
+      const double *Xa = p->x + 3 * a;
       double g[3] = {0, 0, 0};
-      for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-        size_t j = (size_t)nl->index[s];
-        double r3[3], gw[3];
-        for (int c = 0; c < 3; ++c)
-          r3[c] = p->x[3 * a + c] - p->x[3 * j + c];
-        sph_kernel_gradient(&k, r3, hypot3(r3[0], r3[1], r3[2]), gw);
-        for (int c = 0; c < 3; ++c)
+      /* grad C: the neighbours ... */
+      for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
+        const double *Xb = p->x + 3 * (size_t)nl->index[j];
+        double rab[3] = {Xa[0] - Xb[0], Xa[1] - Xb[1], Xa[2] - Xb[2]}, gw[3];
+        double r2 = rab[0] * rab[0] + rab[1] * rab[1] + rab[2] * rab[2];
+        if (r2 >= reach2)
+          continue;
+        sph_kernel_gradient(&k, rab, sqrt(r2), gw);
+        for (int c = 0; c < dim; ++c)
           g[c] += vol * gw[c];
       }
-      double len = 0.0;
-      for (int c = 0; c < dim; ++c) {
-        g[c] *= -diff;
-        len += g[c] * g[c];
+      /* ... and the continuum beyond each wall within reach */
+      wall w[6];
+      int nw = shape_walls(s, dim, Xa, w);
+      for (int i = 0; i < nw; ++i) {
+        double Pw = wall_lookup(P, k.support, -w[i].d);
+        for (int c = 0; c < dim; ++c)
+          g[c] += Pw * w[i].n[c];
       }
-      len = sqrt(len);
-      double scale = len > cap ? cap / len : 1.0;
+      double len = 0.0;
+      for (int c = 0; c < dim; ++c)
+        len += g[c] * g[c];
+      len = diff * sqrt(len);
+      double scale = -diff * (len > cap ? cap / len : 1.0);
       for (int c = 0; c < 3; ++c)
         shift[3 * a + c] = c < dim ? scale * g[c] : 0.0;
     }
     for (size_t a = 0; a < p->n; ++a) {
-      double *X = p->x + 3 * a;
+      double *X = p->x + 3 * a, Y[3] = {X[0], X[1], X[2]};
       for (int c = 0; c < dim; ++c)
-        X[c] += shift[3 * a + c];
-      project_inside(&b->shape, dim, X, 0.5 * dp, 1e-4 * dp);
+        Y[c] += shift[3 * a + c];
+      wall_project(s, dim, Y, 0.5 * dp);
+      /* a shape thinner than dp cannot hold the margin: stay put */
+      if (sph_shape_distance(s, dim, Y) < 0.0)
+        memcpy(X, Y, sizeof Y);
+      double *B = built + 3 * a;
+      double m = hypot3(X[0] - B[0], X[1] - B[1], X[2] - B[2]);
+      moved = m > moved ? m : moved;
     }
   }
-  /* equal volumes that add up to the exact measure */
-  if (st == SPH_OK) {
-    double v = sph_shape_measure(&b->shape, dim) / (double)p->n;
-    for (size_t a = 0; a < p->n; ++a)
-      p->v[a] = v;
-  }
+  free(built);
   free(shift);
   sph_neighbors_destroy(nl);
   return st;
+}
+
+/* ---- bodies -------------------------------------------------------------- */
+
+static const char *shape_name(sph_shape_kind kind) {
+  static const char *const names[] = {"box",  "cylinder", "ring",
+                                      "disc", "sphere",   "shell"};
+  return (int)kind >= 0 && kind <= SPH_SHAPE_SHELL ? names[kind] : "shape";
+}
+
+static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
+  const sph_shape *s = &b->shape;
+  const char *name = shape_name(s->kind);
+  if (dim != 2 && dim != 3)
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': dimension must be 2 or 3, got %d", b->name,
+                         dim);
+  if (dim == 2 && (s->kind == SPH_SHAPE_SPHERE || s->kind == SPH_SHAPE_SHELL ||
+                   s->kind == SPH_SHAPE_CYLINDER))
+    return sph_error_set(
+        err, SPH_ERR_GEOMETRY, "body '%s': a %s is a 3D shape; in 2D use a %s",
+        b->name, name, s->kind == SPH_SHAPE_CYLINDER ? "box" : "disc or ring");
+  if (dim == 3 && s->kind == SPH_SHAPE_DISC)
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': a disc is a 2D shape; in 3D use a "
+                         "cylinder",
+                         b->name);
+  if (dim == 3 && s->kind == SPH_SHAPE_RING && !(s->length > 0.0))
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': a ring in 3D is a tube and needs a "
+                         "positive length, got %g",
+                         b->name, s->length);
+  switch (s->kind) {
+  case SPH_SHAPE_BOX:
+    for (int c = 0; c < dim; ++c)
+      if (!(s->max[c] > s->min[c]))
+        return sph_error_set(err, SPH_ERR_GEOMETRY,
+                             "body '%s': empty box, max[%d] = %g <= min[%d] "
+                             "= %g",
+                             b->name, c, s->max[c], c, s->min[c]);
+    break;
+  case SPH_SHAPE_DISC:
+  case SPH_SHAPE_SPHERE:
+  case SPH_SHAPE_CYLINDER:
+    if (!(s->radius > 0.0))
+      return sph_error_set(err, SPH_ERR_GEOMETRY,
+                           "body '%s': the %s radius must be positive, got %g",
+                           b->name, name, s->radius);
+    break;
+  case SPH_SHAPE_RING:
+  case SPH_SHAPE_SHELL:
+    if (!(s->inner_radius >= 0.0 && s->outer_radius > s->inner_radius))
+      return sph_error_set(err, SPH_ERR_GEOMETRY,
+                           "body '%s': the %s needs 0 <= inner radius < outer "
+                           "radius, got %g and %g",
+                           b->name, name, s->inner_radius, s->outer_radius);
+    break;
+  }
+  if (shape_is_axial(s, dim) &&
+      (s->axis < 0 || s->axis > 2 || !(s->length > 0.0)))
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': the %s needs an axis 0..2 and a positive "
+                         "length, got axis %d, length %g",
+                         b->name, name, s->axis, s->length);
+  if (b->lattice == SPH_LATTICE_FACES) {
+    if (s->kind != SPH_SHAPE_BOX)
+      return sph_error_set(err, SPH_ERR_GEOMETRY,
+                           "body '%s': particle counts apply to boxes; give "
+                           "a spacing for a %s",
+                           b->name, name);
+    for (int c = 0; c < dim; ++c)
+      if (b->count[c] < 2)
+        return sph_error_set(err, SPH_ERR_GEOMETRY,
+                             "body '%s': a face lattice needs at least 2 "
+                             "particles per axis, got %d on axis %d",
+                             b->name, b->count[c], c);
+  } else if (!(b->spacing > 0.0 && isfinite(b->spacing))) {
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': spacing must be positive, got %g", b->name,
+                         b->spacing);
+  }
+  if (b->distribution != SPH_DIST_LATTICE &&
+      !(b->jitter >= 0.0 && b->jitter < 0.5))
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': jitter is a fraction of the spacing in "
+                         "[0, 0.5), got %g",
+                         b->name, b->jitter);
+  return SPH_OK;
 }
 
 sph_status sph_body_generate(const sph_body *b, int dim, double **x,
                              double **volume, size_t *n, sph_error *err) {
   *x = *volume = NULL;
   *n = 0;
-  const sph_shape *s = &b->shape;
-  int is3d = s->kind == SPH_SHAPE_SPHERE || s->kind == SPH_SHAPE_SHELL ||
-             s->kind == SPH_SHAPE_CYLINDER;
-  if (dim == 2 && is3d)
-    return sph_error_set(
-        err, SPH_ERR_GEOMETRY, "body '%s': a %s needs dimension 3", b->name,
-        s->kind == SPH_SHAPE_CYLINDER
-            ? "cylinder"
-            : (s->kind == SPH_SHAPE_SPHERE ? "sphere" : "shell"));
-  if (dim == 3 && s->kind == SPH_SHAPE_DISC)
-    return sph_error_set(err, SPH_ERR_GEOMETRY,
-                         "body '%s': a disc is 2D; use a cylinder in 3D",
-                         b->name);
-  if (b->lattice == SPH_LATTICE_FACES) {
-    if (s->kind != SPH_SHAPE_BOX)
-      return sph_error_set(err, SPH_ERR_GEOMETRY,
-                           "body '%s': particle counts apply to boxes; give "
-                           "a spacing for other shapes",
-                           b->name);
-    for (int c = 0; c < dim; ++c)
-      if (b->count[c] < 2)
-        return sph_error_set(err, SPH_ERR_GEOMETRY,
-                             "body '%s': at least 2 particles per axis, got "
-                             "%d",
-                             b->name, b->count[c]);
-  } else if (!(b->spacing > 0.0)) {
-    return sph_error_set(err, SPH_ERR_GEOMETRY,
-                         "body '%s': spacing must be positive", b->name);
-  }
+  SPH_TRY(check_body(b, dim, err));
   pointset p = {0};
-  int fail = b->lattice == SPH_LATTICE_FACES ? lattice_faces(b, dim, &p)
-                                             : lattice_cells(b, dim, &p);
-  sph_status st = SPH_OK;
-  if (fail)
-    st = sph_error_set(err, SPH_ERR_NOMEM, "particles of body '%s'", b->name);
-  else if (p.n == 0)
+  sph_status st = b->lattice == SPH_LATTICE_FACES
+                      ? lattice_faces(b, dim, &p, err)
+                      : lattice_cells(b, dim, &p, err);
+  if (st == SPH_OK && p.n == 0)
     st = sph_error_set(err, SPH_ERR_GEOMETRY,
                        "body '%s' has no particles: spacing %g is larger than "
                        "the shape",
                        b->name, b->spacing);
   if (st == SPH_OK && b->distribution != SPH_DIST_LATTICE)
     jitter(b, dim, &p);
-  if (st == SPH_OK && b->distribution == SPH_DIST_RELAX)
+  if (st == SPH_OK && b->distribution == SPH_DIST_RELAX) {
     st = relax(b, dim, &p, err);
+    /* equal volumes that add up to the exact measure */
+    double v = sph_shape_measure(&b->shape, dim) / (double)p.n;
+    for (size_t a = 0; st == SPH_OK && a < p.n; ++a)
+      p.v[a] = v;
+  }
   if (st != SPH_OK) {
     free(p.x);
     free(p.v);

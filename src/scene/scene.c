@@ -994,7 +994,9 @@ int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
     const sph_body *b = &s->bodies[sel->body];
     sph_shape_bounds(&b->shape, s->dimension, lo, hi);
     double at = sel->side > 0 ? hi[sel->axis] : lo[sel->axis];
-    return fabs(X[sel->axis] - at) <= 0.5 * b->spacing;
+    /* first layer: on the face (face lattice) or about dp / 2 inside */
+    double tol = (b->lattice == SPH_LATTICE_FACES ? 0.5 : 1.0) * b->spacing;
+    return fabs(X[sel->axis] - at) <= tol;
   }
   }
   return 0;
