@@ -1,10 +1,12 @@
-/* The scene tree: a YAML document from libyaml's document API copied into
- * nodes that keep their file, line, column and dotted path; typed getters
- * that fill defaults and mark keys used; --set overrides; a block-YAML
- * writer; "did you mean" suggestions. */
+/* The scene tree (no paper: input handling, DESIGN.md sec. 6): a YAML
+ * document read with libyaml's document API and copied into nodes that keep
+ * their file, line, column and dotted path; duplicate keys rejected; typed
+ * getters that fill defaults and mark keys used; --set overrides; a block
+ * YAML writer on libyaml's emitter; Levenshtein "did you mean" hints. */
 #include "sph/node.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -13,9 +15,26 @@
 #include <yaml.h>
 
 #define MAX_DEPTH 64
+#define MAX_NODES 1000000
 #define CMDLINE "<command line>"
 
-/* ---- construction ---------------------------------------------------- */
+/* ---- construction ---- */
+
+static char *join_key(const char *parent, const char *key) {
+  size_t len = strlen(parent) + strlen(key) + 2;
+  char *p = malloc(len);
+  if (p)
+    snprintf(p, len, "%s%s%s", parent, *parent ? "." : "", key);
+  return p;
+}
+
+static char *join_index(const char *parent, size_t i) {
+  size_t len = strlen(parent) + 24;
+  char *p = malloc(len);
+  if (p)
+    snprintf(p, len, "%s[%zu]", parent, i);
+  return p;
+}
 
 static sph_node *node_new(sph_node_kind kind, const char *file, int line,
                           int col) {
@@ -31,6 +50,16 @@ static sph_node *node_new(sph_node_kind kind, const char *file, int line,
     free(n->file);
     free(n->path);
     free(n);
+    return NULL;
+  }
+  return n;
+}
+
+static sph_node *scalar_new(const char *text, const char *file, int line,
+                            int col) {
+  sph_node *n = node_new(SPH_NODE_SCALAR, file, line, col);
+  if (n && !(n->value = strdup(text))) {
+    sph_node_destroy(n);
     return NULL;
   }
   return n;
@@ -52,21 +81,26 @@ void sph_node_destroy(sph_node *n) {
   free(n);
 }
 
-/* Appends a child (key ignored for sequences); takes ownership of child. */
+/* Appends a child (key ignored for sequences); takes ownership on success. */
 static int node_append(sph_node *parent, const char *key, sph_node *child) {
   size_t c = parent->count + 1;
-  sph_node **items = realloc(parent->items, c * sizeof *items);
-  if (!items)
+  char *k = NULL;
+  if (parent->kind == SPH_NODE_MAP && !(k = strdup(key ? key : "")))
     return -1;
+  sph_node **items = realloc(parent->items, c * sizeof *items);
+  if (!items) {
+    free(k);
+    return -1;
+  }
   parent->items = items;
   if (parent->kind == SPH_NODE_MAP) {
     char **keys = realloc(parent->keys, c * sizeof *keys);
-    if (!keys)
+    if (!keys) {
+      free(k);
       return -1;
+    }
     parent->keys = keys;
-    keys[c - 1] = strdup(key ? key : "");
-    if (!keys[c - 1])
-      return -1;
+    keys[c - 1] = k;
   }
   items[c - 1] = child;
   parent->count = c;
@@ -79,21 +113,14 @@ static int node_set_path(sph_node *n, const char *path) {
   if (!p)
     return -1;
   free(n->path);
-  n->path = p;
-  path = p; /* the argument may have been the freed path */
+  n->path = p; /* path may have been the old n->path: use p from here */
   for (size_t i = 0; i < n->count; ++i) {
-    size_t len = strlen(path) + (n->keys ? strlen(n->keys[i]) : 24) + 4;
-    char *cp = malloc(len);
-    if (!cp)
-      return -1;
-    if (n->kind == SPH_NODE_MAP)
-      snprintf(cp, len, "%s%s%s", path, *path ? "." : "", n->keys[i]);
-    else
-      snprintf(cp, len, "%s[%zu]", path, i);
-    int rc = node_set_path(n->items[i], cp);
+    char *cp =
+        n->kind == SPH_NODE_MAP ? join_key(p, n->keys[i]) : join_index(p, i);
+    int rc = cp ? node_set_path(n->items[i], cp) : -1;
     free(cp);
     if (rc)
-      return rc;
+      return -1;
   }
   return 0;
 }
@@ -110,22 +137,34 @@ static void node_set_origin(sph_node *n, const char *file, int line, int col) {
     node_set_origin(n->items[i], file, line, col);
 }
 
-/* ---- loading ------------------------------------------------------------ */
+static const char *kind_name(sph_node_kind k) {
+  return k == SPH_NODE_MAP ? "a mapping"
+                           : (k == SPH_NODE_SEQ ? "a sequence" : "a scalar");
+}
+
+/* ---- loading ---- */
 
 typedef struct loader {
   yaml_document_t *doc;
   const char *file;
+  size_t nodes;
+  yaml_node_t *open[MAX_DEPTH + 1]; /* the nodes being converted */
   sph_error *err;
 } loader;
 
-static sph_status convert(loader *L, yaml_node_t *y, int line, int col,
-                          int depth, sph_node **out);
+static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
+                          int col, int depth, sph_node **out);
 
-/* Converts y and appends it to parent under key (NULL in sequences). */
+/* Converts y at `path` and appends it to parent under key (NULL in seqs). */
 static sph_status add_child(loader *L, sph_node *parent, const char *key,
                             yaml_node_t *y, int line, int col, int depth) {
+  char *path = key ? join_key(parent->path, key)
+                   : join_index(parent->path, parent->count);
+  if (!path)
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
   sph_node *child;
-  sph_status st = convert(L, y, line, col, depth, &child);
+  sph_status st = convert(L, y, path, line, col, depth, &child);
+  free(path);
   if (st != SPH_OK)
     return st;
   if (node_append(parent, key, child)) {
@@ -135,111 +174,181 @@ static sph_status add_child(loader *L, sph_node *parent, const char *key,
   return SPH_OK;
 }
 
-static sph_status convert(loader *L, yaml_node_t *y, int line, int col,
-                          int depth, sph_node **out) {
-  *out = NULL;
-  if (depth > MAX_DEPTH)
-    return sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, line, col, NULL,
-                        "document nests deeper than %d levels (recursive "
-                        "alias?)",
-                        MAX_DEPTH);
-  sph_node *n = NULL;
-  switch (y->type) {
-  case YAML_SCALAR_NODE:
-    n = node_new(SPH_NODE_SCALAR, L->file, line, col);
-    if (!n || !(n->value = strndup((const char *)y->data.scalar.value,
-                                   y->data.scalar.length)))
-      break;
-    n->quoted = y->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
-                y->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE ||
-                y->data.scalar.style == YAML_LITERAL_SCALAR_STYLE ||
-                y->data.scalar.style == YAML_FOLDED_SCALAR_STYLE;
-    *out = n;
-    return SPH_OK;
-  case YAML_SEQUENCE_NODE:
-    n = node_new(SPH_NODE_SEQ, L->file, line, col);
-    if (!n)
-      break;
-    for (yaml_node_item_t *it = y->data.sequence.items.start;
-         it < y->data.sequence.items.top; ++it) {
-      yaml_node_t *c = yaml_document_get_node(L->doc, *it);
-      sph_status st = add_child(L, n, NULL, c, (int)c->start_mark.line + 1,
-                                (int)c->start_mark.column + 1, depth + 1);
-      if (st != SPH_OK) {
-        sph_node_destroy(n);
+static sph_status convert_map(loader *L, yaml_node_t *y, sph_node *n,
+                              int depth) {
+  for (yaml_node_pair_t *pr = y->data.mapping.pairs.start;
+       pr < y->data.mapping.pairs.top; ++pr) {
+    yaml_node_t *k = yaml_document_get_node(L->doc, pr->key);
+    yaml_node_t *v = yaml_document_get_node(L->doc, pr->value);
+    int kl = (int)k->start_mark.line + 1, kc = (int)k->start_mark.column + 1;
+    if (k->type != YAML_SCALAR_NODE)
+      return sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, kl, kc, n->path,
+                          "mapping keys must be plain names, not %s",
+                          k->type == YAML_MAPPING_NODE ? "mappings"
+                                                       : "sequences");
+    const char *key = (const char *)k->data.scalar.value;
+    for (size_t i = 0; i < n->count; ++i)
+      if (strcmp(n->keys[i], key) == 0) {
+        char *path = join_key(n->path, key);
+        sph_status st = sph_error_at(
+            L->err, SPH_ERR_DUPLICATE_KEY, L->file, kl, kc, path ? path : key,
+            "duplicate key '%s' (first given on line %d)", key,
+            n->items[i]->line);
+        free(path);
         return st;
       }
-    }
-    *out = n;
-    return SPH_OK;
-  case YAML_MAPPING_NODE:
-    n = node_new(SPH_NODE_MAP, L->file, line, col);
-    if (!n)
-      break;
-    for (yaml_node_pair_t *pr = y->data.mapping.pairs.start;
-         pr < y->data.mapping.pairs.top; ++pr) {
-      yaml_node_t *k = yaml_document_get_node(L->doc, pr->key);
-      yaml_node_t *v = yaml_document_get_node(L->doc, pr->value);
-      int kl = (int)k->start_mark.line + 1, kc = (int)k->start_mark.column + 1;
-      if (k->type != YAML_SCALAR_NODE) {
-        sph_node_destroy(n);
-        return sph_error_at(L->err, SPH_ERR_TYPE, L->file, kl, kc, NULL,
-                            "mapping keys must be plain names");
-      }
-      const char *key = (const char *)k->data.scalar.value;
-      for (size_t i = 0; i < n->count; ++i)
-        if (strcmp(n->keys[i], key) == 0) {
-          int first = n->items[i]->line;
-          sph_node_destroy(n);
-          return sph_error_at(L->err, SPH_ERR_DUPLICATE_KEY, L->file, kl, kc,
-                              key,
-                              "duplicate key '%s' (first given on line "
-                              "%d)",
-                              key, first);
-        }
-      sph_status st = add_child(L, n, key, v, kl, kc, depth + 1);
-      if (st != SPH_OK) {
-        sph_node_destroy(n);
-        return st;
-      }
-    }
-    *out = n;
-    return SPH_OK;
-  default:
-    return sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, line, col, NULL,
-                        "empty node");
+    SPH_TRY(add_child(L, n, key, v, kl, kc, depth + 1));
   }
-  sph_node_destroy(n);
-  return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+  return SPH_OK;
 }
 
-static sph_status load(yaml_parser_t *parser, const char *origin,
-                       sph_node **root, sph_error *err) {
+static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
+                          int col, int depth, sph_node **out) {
+  *out = NULL;
+  /* aliases share nodes: refuse cycles and bound the copy */
+  for (int d = 0; d < depth; ++d)
+    if (L->open[d] == y)
+      return sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, line, col, path,
+                          "recursive alias: the node from line %d, column %d "
+                          "contains itself",
+                          (int)y->start_mark.line + 1,
+                          (int)y->start_mark.column + 1);
+  if (depth > MAX_DEPTH)
+    return sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, line, col, path,
+                        "nesting deeper than %d levels", MAX_DEPTH);
+  L->open[depth] = y;
+  if (++L->nodes > MAX_NODES)
+    return sph_error_at(L->err, SPH_ERR_RANGE, L->file, line, col, path,
+                        "more than %d nodes (aliases expanding?)", MAX_NODES);
+  sph_node_kind kind = y->type == YAML_MAPPING_NODE    ? SPH_NODE_MAP
+                       : y->type == YAML_SEQUENCE_NODE ? SPH_NODE_SEQ
+                                                       : SPH_NODE_SCALAR;
+  sph_node *n = node_new(kind, L->file, line, col);
+  char *p = strdup(path);
+  if (!n || !p) {
+    free(p);
+    sph_node_destroy(n);
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+  }
+  free(n->path);
+  n->path = p;
+  sph_status st = SPH_OK;
+  if (y->type == YAML_SCALAR_NODE) {
+    size_t len = y->data.scalar.length;
+    if (!(n->value = malloc(len + 1))) {
+      sph_node_destroy(n);
+      return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+    }
+    memcpy(n->value, y->data.scalar.value, len);
+    n->value[len] = '\0';
+    yaml_scalar_style_t s = y->data.scalar.style;
+    n->quoted = s == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+                s == YAML_DOUBLE_QUOTED_SCALAR_STYLE ||
+                s == YAML_LITERAL_SCALAR_STYLE || s == YAML_FOLDED_SCALAR_STYLE;
+  } else if (y->type == YAML_SEQUENCE_NODE) {
+    for (yaml_node_item_t *it = y->data.sequence.items.start;
+         it < y->data.sequence.items.top && st == SPH_OK; ++it) {
+      yaml_node_t *c = yaml_document_get_node(L->doc, *it);
+      st = add_child(L, n, NULL, c, (int)c->start_mark.line + 1,
+                     (int)c->start_mark.column + 1, depth + 1);
+    }
+  } else if (y->type == YAML_MAPPING_NODE) {
+    st = convert_map(L, y, n, depth);
+  } else {
+    st = sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, line, col, path,
+                      "empty node");
+  }
+  if (st != SPH_OK) {
+    sph_node_destroy(n);
+    return st;
+  }
+  *out = n;
+  return SPH_OK;
+}
+
+/* libyaml's problem as an error at its position. */
+static sph_status parse_error(const yaml_parser_t *p, const char *text,
+                              size_t len, const char *origin, sph_error *err) {
+  if (p->error == YAML_MEMORY_ERROR)
+    return sph_error_set(err, SPH_ERR_NOMEM, "YAML parser");
+  const char *problem = p->problem ? p->problem : "malformed document";
+  if (p->error == YAML_READER_ERROR) {
+    /* reader errors carry a byte offset: count lines and characters */
+    int line = 1, col = 1;
+    for (size_t i = 0; i < p->problem_offset && i < len; ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else if (((unsigned char)text[i] & 0xC0) != 0x80) {
+        ++col;
+      }
+    }
+    return sph_error_at(err, SPH_ERR_SYNTAX, origin, line, col, NULL,
+                        "YAML syntax: %s", problem);
+  }
+  int line = (int)p->problem_mark.line + 1;
+  int col = (int)p->problem_mark.column + 1;
+  if (p->context)
+    return sph_error_at(err, SPH_ERR_SYNTAX, origin, line, col, NULL,
+                        "YAML syntax: %s (%s at line %d, column %d)", problem,
+                        p->context, (int)p->context_mark.line + 1,
+                        (int)p->context_mark.column + 1);
+  return sph_error_at(err, SPH_ERR_SYNTAX, origin, line, col, NULL,
+                      "YAML syntax: %s", problem);
+}
+
+/* Parses one YAML document from text; an empty one is an error unless
+ * allow_empty, which gives an empty scalar. */
+static sph_status load_text(const char *text, size_t len, const char *origin,
+                            int allow_empty, sph_node **root, sph_error *err) {
+  *root = NULL;
+  yaml_parser_t parser;
+  if (!yaml_parser_initialize(&parser))
+    return sph_error_set(err, SPH_ERR_NOMEM, "YAML parser");
+  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
   yaml_document_t doc;
-  if (!yaml_parser_load(parser, &doc)) {
-    sph_status st = sph_error_at(
-        err, SPH_ERR_SYNTAX, origin, (int)parser->problem_mark.line + 1,
-        (int)parser->problem_mark.column + 1, NULL, "YAML syntax: %s%s%s",
-        parser->problem ? parser->problem : "malformed document",
-        parser->context ? " " : "", parser->context ? parser->context : "");
+  if (!yaml_parser_load(&parser, &doc)) {
+    sph_status st = parse_error(&parser, text, len, origin, err);
+    yaml_parser_delete(&parser);
     return st;
   }
   yaml_node_t *top = yaml_document_get_root_node(&doc);
-  sph_status st;
-  if (!top) {
+  int empty = !top || (top->type == YAML_SCALAR_NODE &&
+                       top->data.scalar.style == YAML_PLAIN_SCALAR_STYLE &&
+                       top->data.scalar.length == 0);
+  sph_status st = SPH_OK;
+  if (empty && allow_empty) {
+    if (!(*root = scalar_new("", origin, 1, 1)))
+      st = sph_error_set(err, SPH_ERR_NOMEM, "scene tree");
+  } else if (empty) {
     st = sph_error_at(err, SPH_ERR_SYNTAX, origin, 1, 1, NULL,
                       "the document is empty");
   } else {
-    loader L = {&doc, origin, err};
-    st = convert(&L, top, (int)top->start_mark.line + 1,
+    loader L = {.doc = &doc, .file = origin, .err = err};
+    st = convert(&L, top, "", (int)top->start_mark.line + 1,
                  (int)top->start_mark.column + 1, 0, root);
-    if (st == SPH_OK && node_set_path(*root, "")) {
-      sph_node_destroy(*root);
-      *root = NULL;
-      st = sph_error_set(err, SPH_ERR_NOMEM, "scene tree");
-    }
   }
   yaml_document_delete(&doc);
+
+  /* a second document would be ignored silently: refuse it */
+  if (st == SPH_OK) {
+    if (!yaml_parser_load(&parser, &doc)) {
+      st = parse_error(&parser, text, len, origin, err);
+    } else {
+      yaml_node_t *next = yaml_document_get_root_node(&doc);
+      if (next)
+        st = sph_error_at(err, SPH_ERR_SYNTAX, origin,
+                          (int)next->start_mark.line + 1,
+                          (int)next->start_mark.column + 1, NULL,
+                          "YAML syntax: only one document is allowed");
+      yaml_document_delete(&doc);
+    }
+    if (st != SPH_OK) {
+      sph_node_destroy(*root);
+      *root = NULL;
+    }
+  }
+  yaml_parser_delete(&parser);
   return st;
 }
 
@@ -249,29 +358,38 @@ sph_status sph_node_load_file(sph_node **root, const char *path,
   FILE *f = fopen(path, "rb");
   if (!f)
     return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
-                        "cannot open the scene file");
-  yaml_parser_t parser;
-  yaml_parser_initialize(&parser);
-  yaml_parser_set_input_file(&parser, f);
-  sph_status st = load(&parser, path, root, err);
-  yaml_parser_delete(&parser);
+                        "cannot open the scene file: %s", strerror(errno));
+  /* read it whole: reader errors are reported by offset into the text */
+  size_t len = 0, cap = 4096;
+  char *text = malloc(cap);
+  while (text) {
+    len += fread(text + len, 1, cap - len, f);
+    if (len < cap)
+      break;
+    char *t = realloc(text, cap *= 2);
+    if (!t)
+      free(text);
+    text = t;
+  }
+  int bad = !text || ferror(f);
   fclose(f);
+  if (bad) {
+    free(text);
+    return text ? sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
+                               "cannot read the scene file")
+                : sph_error_set(err, SPH_ERR_NOMEM, "reading %s", path);
+  }
+  sph_status st = load_text(text, len, path, 0, root, err);
+  free(text);
   return st;
 }
 
 sph_status sph_node_load_string(sph_node **root, const char *text,
                                 const char *origin, sph_error *err) {
-  *root = NULL;
-  yaml_parser_t parser;
-  yaml_parser_initialize(&parser);
-  yaml_parser_set_input_string(&parser, (const unsigned char *)text,
-                               strlen(text));
-  sph_status st = load(&parser, origin, root, err);
-  yaml_parser_delete(&parser);
-  return st;
+  return load_text(text, strlen(text), origin, 0, root, err);
 }
 
-/* ---- lookups and errors -------------------------------------------------- */
+/* ---- lookups and errors ---- */
 
 sph_node *sph_node_child(const sph_node *map, const char *key) {
   if (!map || map->kind != SPH_NODE_MAP)
@@ -289,17 +407,16 @@ sph_status sph_node_error(const sph_node *n, sph_error *err, sph_status code,
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
+  if (!n)
+    return sph_error_set(err, code, "%s", msg);
   return sph_error_at(err, code, n->file, n->line, n->col, n->path, "%s", msg);
-}
-
-static const char *kind_name(sph_node_kind k) {
-  return k == SPH_NODE_MAP ? "a mapping"
-                           : (k == SPH_NODE_SEQ ? "a sequence" : "a scalar");
 }
 
 size_t sph_edit_distance(const char *a, const char *b) {
   size_t la = strlen(a), lb = strlen(b);
-  size_t row[lb + 1];
+  size_t *row = malloc((lb + 1) * sizeof *row);
+  if (!row)
+    return la > lb ? la : lb; /* an upper bound */
   for (size_t j = 0; j <= lb; ++j)
     row[j] = j;
   for (size_t i = 1; i <= la; ++i) {
@@ -307,8 +424,7 @@ size_t sph_edit_distance(const char *a, const char *b) {
     row[0] = i;
     for (size_t j = 1; j <= lb; ++j) {
       size_t up = row[j];
-      size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-      size_t best = diag + cost;
+      size_t best = diag + (a[i - 1] != b[j - 1]);
       if (up + 1 < best)
         best = up + 1;
       if (row[j - 1] + 1 < best)
@@ -317,7 +433,9 @@ size_t sph_edit_distance(const char *a, const char *b) {
       diag = up;
     }
   }
-  return row[lb];
+  size_t d = row[lb];
+  free(row);
+  return d;
 }
 
 const char *sph_suggest(const char *word, const char *const *candidates) {
@@ -326,9 +444,9 @@ const char *sph_suggest(const char *word, const char *const *candidates) {
   size_t limit = len / 3 > 2 ? len / 3 : 2;
   for (const char *const *c = candidates; *c; ++c) {
     size_t d = sph_edit_distance(word, *c);
-    /* a prefix of a longer key ("poisson" for "poisson_ratio") counts too */
-    if (len >= 3 && strncmp(word, *c, len) == 0)
-      d = d < 1 ? d : 1;
+    /* a prefix of a longer key ("poisson" for "poisson_ratio") counts as 1 */
+    if (len >= 3 && strncmp(word, *c, len) == 0 && d > 1)
+      d = 1;
     if (d < best_d) {
       best_d = d;
       best = *c;
@@ -363,8 +481,7 @@ sph_status sph_node_check_keys(const sph_node *map, const char *const *allowed,
   return SPH_OK;
 }
 
-/* ---- scalar conversions ----------------------------------------------------
- */
+/* ---- scalar conversions ---- */
 
 static sph_status need_scalar(const sph_node *n, const char *what,
                               sph_error *err) {
@@ -379,41 +496,45 @@ static sph_status need_scalar(const sph_node *n, const char *what,
 }
 
 sph_status sph_node_as_double(const sph_node *n, double *out, sph_error *err) {
-  sph_status st = need_scalar(n, "a number", err);
-  if (st != SPH_OK)
-    return st;
+  SPH_TRY(need_scalar(n, "a number", err));
   const char *s = n->value;
-  char *end;
-  double v = strtod(s, &end);
-  int bad = end == s || *end != '\0' || isspace((unsigned char)*s);
-  /* strtod accepts "inf", "nan" and hex floats; YAML numbers are decimal */
+  /* decimal only: strtod would also take "inf", "nan" and hex floats */
+  int bad = *s == '\0';
   for (const char *c = s; *c && !bad; ++c)
     bad = !(isdigit((unsigned char)*c) || strchr("+-.eE", *c));
-  if (bad || !isfinite(v))
+  char *end = NULL;
+  double v = bad ? 0.0 : strtod(s, &end);
+  if (bad || end == s || *end != '\0')
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a number, got '%s'",
                           s);
+  if (!isfinite(v))
+    return sph_node_error(n, err, SPH_ERR_RANGE,
+                          "the number '%s' is out of range", s);
   *out = v;
   return SPH_OK;
 }
 
 sph_status sph_node_as_int(const sph_node *n, long *out, sph_error *err) {
-  sph_status st = need_scalar(n, "an integer", err);
-  if (st != SPH_OK)
-    return st;
+  SPH_TRY(need_scalar(n, "an integer", err));
   const char *s = n->value;
-  char *end;
-  long v = strtol(s, &end, 10);
-  if (end == s || *end != '\0' || isspace((unsigned char)*s))
+  int bad = *s == '\0';
+  for (const char *c = s; *c && !bad; ++c)
+    bad = !(isdigit((unsigned char)*c) || (c == s && strchr("+-", *c)));
+  char *end = NULL;
+  errno = 0;
+  long v = bad ? 0 : strtol(s, &end, 10);
+  if (bad || end == s || *end != '\0')
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected an integer, got '%s'",
                           s);
+  if (errno == ERANGE)
+    return sph_node_error(n, err, SPH_ERR_RANGE,
+                          "the integer '%s' is out of range", s);
   *out = v;
   return SPH_OK;
 }
 
 sph_status sph_node_as_bool(const sph_node *n, int *out, sph_error *err) {
-  sph_status st = need_scalar(n, "true or false", err);
-  if (st != SPH_OK)
-    return st;
+  SPH_TRY(need_scalar(n, "true or false", err));
   static const char *const yes[] = {"true", "yes", "on"};
   static const char *const no[] = {"false", "no", "off"};
   for (int i = 0; i < 3; ++i) {
@@ -430,38 +551,42 @@ sph_status sph_node_as_bool(const sph_node *n, int *out, sph_error *err) {
                         "expected true or false, got '%s'", n->value);
 }
 
-/* ---- getters
- * ----------------------------------------------------------------- */
+/* ---- getters ---- */
 
-static sph_status missing(sph_node *map, const char *key, sph_error *err) {
-  char path[512];
-  snprintf(path, sizeof path, "%s%s%s", map->path, *map->path ? "." : "", key);
-  return sph_error_at(err, SPH_ERR_MISSING_KEY, map->file, map->line, map->col,
-                      path, "missing required key '%s'", key);
+static sph_status missing(const sph_node *map, const char *key,
+                          sph_error *err) {
+  char *path = join_key(map->path, key);
+  sph_status st =
+      sph_error_at(err, SPH_ERR_MISSING_KEY, map->file, map->line, map->col,
+                   path ? path : key, "missing required key '%s'", key);
+  free(path);
+  return st;
 }
 
-/* Inserts a default scalar child and returns it (NULL on no memory). */
-static sph_node *insert_default(sph_node *map, const char *key,
-                                const char *text) {
-  if (map->kind != SPH_NODE_MAP)
-    return NULL;
-  sph_node *n = node_new(SPH_NODE_SCALAR, map->file, map->line, map->col);
-  if (!n || !(n->value = strdup(text)) || node_append(map, key, n)) {
+/* Appends n to map under key as a default (path set); NULL on no memory. */
+static sph_node *adopt_default(sph_node *map, const char *key, sph_node *n) {
+  char *p = join_key(map->path, key);
+  if (!n || !p || node_set_path(n, p) || node_append(map, key, n)) {
+    free(p);
     sph_node_destroy(n);
     return NULL;
   }
-  size_t len = strlen(map->path) + strlen(key) + 2;
-  char *p = malloc(len);
-  if (p) {
-    snprintf(p, len, "%s%s%s", map->path, *map->path ? "." : "", key);
-    free(n->path);
-    n->path = p;
-  }
+  free(p);
   n->is_default = 1;
   n->used = 1;
   return n;
 }
 
+static sph_status insert_scalar(sph_node *map, const char *key,
+                                const char *text, sph_node **out,
+                                sph_error *err) {
+  *out =
+      adopt_default(map, key, scalar_new(text, map->file, map->line, map->col));
+  return *out ? SPH_OK
+              : sph_error_set(err, SPH_ERR_NOMEM, "default for '%s'", key);
+}
+
+/* Shortest %g form that reads back to v ("0.3", not "0.29999999999999999"). */
 static void format_double(double v, char *buf, size_t size) {
   for (int prec = 1; prec <= 17; ++prec) {
     snprintf(buf, size, "%.*g", prec, v);
@@ -470,93 +595,78 @@ static void format_double(double v, char *buf, size_t size) {
   }
 }
 
-/* Finds key; NULL child with SPH_OK means absent and optional. */
+/* Finds key in map (marking it used); NULL with SPH_OK when optional and
+ * absent. */
 static sph_status lookup(sph_node *map, const char *key, int required,
                          sph_node **child, sph_error *err) {
   *child = NULL;
-  if (!map || map->kind != SPH_NODE_MAP)
-    return map ? sph_node_error(map, err, SPH_ERR_TYPE,
-                                "expected a mapping, got %s",
-                                kind_name(map->kind))
-               : sph_error_set(err, SPH_ERR_ARG, "no mapping for '%s'", key);
+  if (!map)
+    return sph_error_set(err, SPH_ERR_ARG, "no mapping to read '%s' from", key);
+  if (map->kind != SPH_NODE_MAP)
+    return sph_node_error(map, err, SPH_ERR_TYPE,
+                          "expected a mapping with '%s', got %s", key,
+                          kind_name(map->kind));
   *child = sph_node_child(map, key);
-  if (!*child && required)
-    return missing(map, key, err);
-  if (*child)
-    (*child)->used = 1;
+  if (!*child)
+    return required ? missing(map, key, err) : SPH_OK;
+  (*child)->used = 1;
   return SPH_OK;
 }
 
 sph_status sph_node_get_double(sph_node *map, const char *key, int required,
                                double def, double *out, sph_error *err) {
   sph_node *c;
-  sph_status st = lookup(map, key, required, &c, err);
-  if (st != SPH_OK)
-    return st;
-  if (!c) {
-    char buf[40];
-    format_double(def, buf, sizeof buf);
-    if (!insert_default(map, key, buf))
-      return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
-    *out = def;
-    return SPH_OK;
-  }
-  return sph_node_as_double(c, out, err);
+  SPH_TRY(lookup(map, key, required, &c, err));
+  if (c)
+    return sph_node_as_double(c, out, err);
+  char buf[40];
+  format_double(def, buf, sizeof buf);
+  SPH_TRY(insert_scalar(map, key, buf, &c, err));
+  *out = def;
+  return SPH_OK;
 }
 
 sph_status sph_node_get_int(sph_node *map, const char *key, int required,
                             long def, long *out, sph_error *err) {
   sph_node *c;
-  sph_status st = lookup(map, key, required, &c, err);
-  if (st != SPH_OK)
-    return st;
-  if (!c) {
-    char buf[32];
-    snprintf(buf, sizeof buf, "%ld", def);
-    if (!insert_default(map, key, buf))
-      return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
-    *out = def;
-    return SPH_OK;
-  }
-  return sph_node_as_int(c, out, err);
+  SPH_TRY(lookup(map, key, required, &c, err));
+  if (c)
+    return sph_node_as_int(c, out, err);
+  char buf[32];
+  snprintf(buf, sizeof buf, "%ld", def);
+  SPH_TRY(insert_scalar(map, key, buf, &c, err));
+  *out = def;
+  return SPH_OK;
 }
 
 sph_status sph_node_get_bool(sph_node *map, const char *key, int required,
                              int def, int *out, sph_error *err) {
   sph_node *c;
-  sph_status st = lookup(map, key, required, &c, err);
-  if (st != SPH_OK)
-    return st;
-  if (!c) {
-    if (!insert_default(map, key, def ? "true" : "false"))
-      return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
-    *out = def;
-    return SPH_OK;
-  }
-  return sph_node_as_bool(c, out, err);
+  SPH_TRY(lookup(map, key, required, &c, err));
+  if (c)
+    return sph_node_as_bool(c, out, err);
+  SPH_TRY(insert_scalar(map, key, def ? "true" : "false", &c, err));
+  *out = def != 0;
+  return SPH_OK;
 }
 
 sph_status sph_node_get_string(sph_node *map, const char *key, int required,
                                const char *def, const char **out,
                                sph_error *err) {
   sph_node *c;
-  sph_status st = lookup(map, key, required, &c, err);
-  if (st != SPH_OK)
-    return st;
-  if (!c) {
-    *out = def;
-    if (def) {
-      sph_node *d = insert_default(map, key, def);
-      if (!d)
-        return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
-      *out = d->value;
-    }
+  *out = NULL;
+  SPH_TRY(lookup(map, key, required, &c, err));
+  if (c) {
+    if (c->kind != SPH_NODE_SCALAR)
+      return sph_node_error(c, err, SPH_ERR_TYPE, "expected a string, got %s",
+                            kind_name(c->kind));
+    *out = c->value;
     return SPH_OK;
   }
-  if (c->kind != SPH_NODE_SCALAR)
-    return sph_node_error(c, err, SPH_ERR_TYPE, "expected a name, got %s",
-                          kind_name(c->kind));
-  *out = c->value;
+  if (def) {
+    SPH_TRY(insert_scalar(map, key, def, &c, err));
+    *out = c->value;
+  }
   return SPH_OK;
 }
 
@@ -570,26 +680,24 @@ sph_status sph_node_get_doubles(sph_node *map, const char *key, int required,
   sph_status st = lookup(map, key, required, &c, err);
   if (st != SPH_OK || !c)
     return st;
-  if (c->kind != SPH_NODE_SEQ) {
-    if (n)
-      return sph_node_error(
-          c, err, SPH_ERR_TYPE, "expected a sequence of %zu numbers, got %s", n,
-          c->kind == SPH_NODE_SCALAR ? c->value : kind_name(c->kind));
-    return sph_node_error(
-        c, err, SPH_ERR_TYPE, "expected a sequence of numbers, got %s",
-        c->kind == SPH_NODE_SCALAR ? c->value : kind_name(c->kind));
-  }
+  char want[48] = "a sequence of numbers";
+  if (n)
+    snprintf(want, sizeof want, "a sequence of %zu numbers", n);
+  if (c->kind == SPH_NODE_SCALAR)
+    return sph_node_error(c, err, SPH_ERR_TYPE, "expected %s, got '%s'", want,
+                          c->value);
+  if (c->kind != SPH_NODE_SEQ)
+    return sph_node_error(c, err, SPH_ERR_TYPE, "expected %s, got %s", want,
+                          kind_name(c->kind));
   if (n && c->count != n)
-    return sph_node_error(c, err, SPH_ERR_TYPE,
-                          "expected a sequence of %zu numbers, got %zu", n,
+    return sph_node_error(c, err, SPH_ERR_TYPE, "expected %s, got %zu", want,
                           c->count);
   if (!n && c->count > cap)
     return sph_node_error(c, err, SPH_ERR_RANGE,
-                          "at most %zu numbers allowed, got %zu", cap,
+                          "expected at most %zu numbers, got %zu", cap,
                           c->count);
   for (size_t i = 0; i < c->count; ++i)
-    if ((st = sph_node_as_double(c->items[i], &out[i], err)) != SPH_OK)
-      return st;
+    SPH_TRY(sph_node_as_double(c->items[i], &out[i], err));
   if (got)
     *got = c->count;
   return SPH_OK;
@@ -604,8 +712,7 @@ sph_status sph_node_get_map(sph_node *map, const char *key, int required,
     return st;
   if (c->kind != SPH_NODE_MAP)
     return sph_node_error(c, err, SPH_ERR_TYPE, "expected a mapping, got %s",
-                          c->kind == SPH_NODE_SCALAR ? "a scalar"
-                                                     : "a sequence");
+                          kind_name(c->kind));
   *out = c;
   return SPH_OK;
 }
@@ -613,39 +720,22 @@ sph_status sph_node_get_map(sph_node *map, const char *key, int required,
 sph_status sph_node_insert_default(sph_node *map, const char *key,
                                    const char *yaml, sph_node **out,
                                    sph_error *err) {
-  *out = sph_node_child(map, key);
-  if (*out) {
-    (*out)->used = 1;
+  *out = NULL;
+  sph_node *c;
+  SPH_TRY(lookup(map, key, 0, &c, err));
+  if (c) {
+    *out = c;
     return SPH_OK;
   }
-  if (map->kind != SPH_NODE_MAP)
-    return sph_node_error(map, err, SPH_ERR_TYPE, "expected a mapping, got %s",
-                          kind_name(map->kind));
   sph_node *n = NULL;
-  sph_status st = sph_node_load_string(&n, yaml, map->file, err);
-  if (st != SPH_OK)
-    return st;
+  SPH_TRY(load_text(yaml, strlen(yaml), map->file, 1, &n, err));
   node_set_origin(n, map->file, map->line, map->col);
-  n->is_default = 1;
-  n->used = 1;
-  size_t len = strlen(map->path) + strlen(key) + 2;
-  char *p = malloc(len);
-  if (!p || node_append(map, key, n)) {
-    free(p);
-    sph_node_destroy(n);
-    return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
-  }
-  snprintf(p, len, "%s%s%s", map->path, *map->path ? "." : "", key);
-  int rc = node_set_path(n, p);
-  free(p);
-  if (rc)
-    return sph_error_set(err, SPH_ERR_NOMEM, "default for %s", key);
-  *out = n;
+  if (!(*out = adopt_default(map, key, n)))
+    return sph_error_set(err, SPH_ERR_NOMEM, "default for '%s'", key);
   return SPH_OK;
 }
 
-/* ---- overrides
- * --------------------------------------------------------------- */
+/* ---- overrides ---- */
 
 static int is_index(const char *s) {
   if (!*s)
@@ -658,71 +748,82 @@ static int is_index(const char *s) {
 
 sph_status sph_node_set(sph_node *root, const char *assignment,
                         sph_error *err) {
-  const char *eq = strchr(assignment, '=');
+  const char *eq = root && assignment ? strchr(assignment, '=') : NULL;
   if (!eq || eq == assignment)
     return sph_error_at(err, SPH_ERR_ARG, CMDLINE, 0, 0, NULL,
-                        "--set expects key.path=value, got '%s'", assignment);
-  size_t klen = (size_t)(eq - assignment);
+                        "--set expects key.path=value, got '%s'",
+                        assignment ? assignment : "(null)");
   char key[512];
+  size_t klen = (size_t)(eq - assignment);
   if (klen >= sizeof key)
-    return sph_error_set(err, SPH_ERR_ARG, "--set key is too long");
+    return sph_error_at(err, SPH_ERR_ARG, CMDLINE, 0, 0, NULL,
+                        "--set key is longer than %zu characters",
+                        sizeof key - 1);
   memcpy(key, assignment, klen);
   key[klen] = '\0';
+  if (key[0] == '.' || key[klen - 1] == '.' || strstr(key, ".."))
+    return sph_error_at(err, SPH_ERR_ARG, CMDLINE, 1, 1, NULL,
+                        "--set key '%s' has an empty part", key);
+
+  /* the value, parsed as YAML; it sits at column klen + 2 */
   const char *text = eq + 1;
   int col = (int)klen + 2;
-
-  /* the value, parsed as YAML */
   sph_node *value = NULL;
   sph_error verr;
-  if (*text == '\0') {
-    value = node_new(SPH_NODE_SCALAR, CMDLINE, 1, col);
-    if (!value || !(value->value = strdup(""))) {
-      sph_node_destroy(value);
-      return sph_error_set(err, SPH_ERR_NOMEM, "--set value");
-    }
-  } else if (sph_node_load_string(&value, text, CMDLINE, &verr) != SPH_OK) {
-    return sph_error_at(err, SPH_ERR_SYNTAX, CMDLINE, 1, col, key,
-                        "cannot read the value '%s': %s", text, verr.message);
-  }
+  sph_error_clear(&verr);
+  sph_status st = load_text(text, strlen(text), CMDLINE, 1, &value, &verr);
+  if (st != SPH_OK)
+    return sph_error_at(
+        err, st, CMDLINE, 1,
+        verr.line == 1 && verr.col > 0 ? col + verr.col - 1 : col, NULL,
+        "cannot read the value of %s: %s", key, verr.message);
   node_set_origin(value, CMDLINE, 1, col);
 
   /* walk to the parent, creating maps */
   sph_node *cur = root;
-  char *save = NULL, *part = strtok_r(key, ".", &save);
-  char walked[512] = "";
-  sph_status st = SPH_OK;
-  while (part) {
-    char *next = strtok_r(NULL, ".", &save);
-    char here[512];
-    snprintf(here, sizeof here, "%s%s%s", walked, *walked ? "." : "", part);
+  char here[600];
+  snprintf(here, sizeof here, "%s", root->path);
+  for (char *part = key; part && st == SPH_OK;) {
+    char *next = strchr(part, '.');
+    if (next)
+      *next++ = '\0';
+    char walked[600];
+    snprintf(walked, sizeof walked, "%s", *here ? here : "(root)");
+    sph_node **slot = NULL;
     if (cur->kind == SPH_NODE_SCALAR) {
-      st = sph_error_at(err, SPH_ERR_TYPE, CMDLINE, 1, 1, here,
-                        "cannot set '%s': '%s' is a scalar", assignment,
-                        *walked ? walked : "(root)");
+      st =
+          sph_error_at(err, SPH_ERR_TYPE, CMDLINE, 1, 1, here,
+                       "cannot set '%s': '%s' is a scalar", assignment, walked);
       break;
     }
-    sph_node **slot = NULL;
     if (cur->kind == SPH_NODE_SEQ) {
+      size_t len = strlen(here);
+      snprintf(here + len, sizeof here - len, "[%s]", part);
       if (!is_index(part)) {
-        st = sph_error_at(err, SPH_ERR_TYPE, CMDLINE, 1, 1, here,
-                          "'%s' is a sequence: use an index, e.g. %s.0", walked,
-                          walked);
+        st = sph_error_at(err, SPH_ERR_TYPE, CMDLINE, 1, 1, walked,
+                          "'%s' is a sequence: index it by number, e.g. "
+                          "%s.0",
+                          walked, walked);
         break;
       }
-      size_t i = strtoul(part, NULL, 10);
-      if (i >= cur->count) {
+      errno = 0;
+      unsigned long i = strtoul(part, NULL, 10);
+      if (errno == ERANGE || i >= cur->count) {
         st = sph_error_at(err, SPH_ERR_RANGE, CMDLINE, 1, 1, here,
-                          "index %zu is past the end of '%s' (%zu entries)", i,
-                          walked, cur->count);
+                          "index %s is past the end of '%s' (%zu entries)",
+                          part, walked, cur->count);
         break;
       }
       slot = &cur->items[i];
     } else {
-      for (size_t i = 0; i < cur->count; ++i)
+      size_t len = strlen(here);
+      snprintf(here + len, sizeof here - len, "%s%s", len ? "." : "", part);
+      for (size_t i = 0; i < cur->count && !slot; ++i)
         if (!strcmp(cur->keys[i], part))
           slot = &cur->items[i];
     }
     if (!next) {
+      /* last part: replace or add */
       if (slot) {
         sph_node_destroy(*slot);
         *slot = value;
@@ -731,11 +832,13 @@ sph_status sph_node_set(sph_node *root, const char *assignment,
         break;
       }
       value = NULL;
+      if (node_set_path(slot ? *slot : cur->items[cur->count - 1], here))
+        st = sph_error_set(err, SPH_ERR_NOMEM, "--set");
       break;
     }
     if (!slot) {
       sph_node *m = node_new(SPH_NODE_MAP, CMDLINE, 1, 1);
-      if (!m || node_append(cur, part, m)) {
+      if (!m || node_set_path(m, here) || node_append(cur, part, m)) {
         sph_node_destroy(m);
         st = sph_error_set(err, SPH_ERR_NOMEM, "--set");
         break;
@@ -743,47 +846,21 @@ sph_status sph_node_set(sph_node *root, const char *assignment,
       slot = &cur->items[cur->count - 1];
     }
     cur = *slot;
-    snprintf(walked, sizeof walked, "%s", here);
     part = next;
   }
   sph_node_destroy(value);
-  if (st == SPH_OK && node_set_path(root, root->path))
-    st = sph_error_set(err, SPH_ERR_NOMEM, "--set");
   return st;
 }
 
-/* ---- writing
- * ----------------------------------------------------------------- */
+/* ---- writing (libyaml's emitter picks a safe quoting for each scalar) ---- */
 
-static int needs_quotes(const sph_node *n) {
-  const char *s = n->value;
-  if (n->quoted || !*s)
-    return 1;
-  if (strchr("-?:,[]{}#&*!|>'\"%@` ", s[0]))
-    return !(s[0] == '-' && (isdigit((unsigned char)s[1]) || s[1] == '.'));
-  if (s[strlen(s) - 1] == ' ' || strstr(s, ": ") || strstr(s, " #") ||
-      strchr(s, '\n') || strchr(s, '\t'))
-    return 1;
-  return 0;
-}
-
-static void write_scalar(const sph_node *n, FILE *out) {
-  if (!needs_quotes(n)) {
-    fputs(n->value, out);
-    return;
-  }
-  fputc('"', out);
-  for (const char *c = n->value; *c; ++c) {
-    if (*c == '"' || *c == '\\')
-      fputc('\\', out);
-    if (*c == '\n')
-      fputs("\\n", out);
-    else if (*c == '\t')
-      fputs("\\t", out);
-    else
-      fputc(*c, out);
-  }
-  fputc('"', out);
+static int emit_scalar(yaml_emitter_t *e, const char *text, int quoted) {
+  yaml_event_t ev;
+  if (!yaml_scalar_event_initialize(
+          &ev, NULL, NULL, (yaml_char_t *)text, (int)strlen(text), 1, 1,
+          quoted ? YAML_DOUBLE_QUOTED_SCALAR_STYLE : YAML_ANY_SCALAR_STYLE))
+    return 0;
+  return yaml_emitter_emit(e, &ev);
 }
 
 static int all_scalars(const sph_node *n) {
@@ -793,62 +870,57 @@ static int all_scalars(const sph_node *n) {
   return 1;
 }
 
-static void write_node(const sph_node *n, int indent, FILE *out);
-
-/* Writes the value part after "key:" or "- ". */
-static void write_value(const sph_node *v, int indent, FILE *out) {
-  if (v->kind == SPH_NODE_SCALAR) {
-    fputc(' ', out);
-    write_scalar(v, out);
-    fputc('\n', out);
-  } else if (v->count == 0) {
-    fputs(v->kind == SPH_NODE_MAP ? " {}\n" : " []\n", out);
-  } else if (v->kind == SPH_NODE_SEQ && all_scalars(v)) {
-    fputs(" [", out);
-    for (size_t i = 0; i < v->count; ++i) {
-      if (i)
-        fputs(", ", out);
-      write_scalar(v->items[i], out);
-    }
-    fputs("]\n", out);
-  } else {
-    fputc('\n', out);
-    write_node(v, indent + 2, out);
+static int emit_node(yaml_emitter_t *e, const sph_node *n) {
+  yaml_event_t ev;
+  if (n->kind == SPH_NODE_SCALAR)
+    return emit_scalar(e, n->value, n->quoted);
+  /* empty collections and lists of scalars in flow style: "[1, 2, 3]" */
+  int flow = n->count == 0 || (n->kind == SPH_NODE_SEQ && all_scalars(n));
+  int ok;
+  if (n->kind == SPH_NODE_MAP)
+    ok = yaml_mapping_start_event_initialize(&ev, NULL, NULL, 1,
+                                             flow ? YAML_FLOW_MAPPING_STYLE
+                                                  : YAML_BLOCK_MAPPING_STYLE);
+  else
+    ok = yaml_sequence_start_event_initialize(&ev, NULL, NULL, 1,
+                                              flow ? YAML_FLOW_SEQUENCE_STYLE
+                                                   : YAML_BLOCK_SEQUENCE_STYLE);
+  if (!ok || !yaml_emitter_emit(e, &ev))
+    return 0;
+  for (size_t i = 0; i < n->count; ++i) {
+    if (n->kind == SPH_NODE_MAP && !emit_scalar(e, n->keys[i], 0))
+      return 0;
+    if (!emit_node(e, n->items[i]))
+      return 0;
   }
-}
-
-static void write_node(const sph_node *n, int indent, FILE *out) {
-  if (n->kind == SPH_NODE_MAP) {
-    for (size_t i = 0; i < n->count; ++i) {
-      fprintf(out, "%*s%s:", indent, "", n->keys[i]);
-      write_value(n->items[i], indent, out);
-    }
-  } else if (n->kind == SPH_NODE_SEQ) {
-    for (size_t i = 0; i < n->count; ++i) {
-      const sph_node *it = n->items[i];
-      if (it->kind == SPH_NODE_MAP && it->count > 0) {
-        /* "- first: v" then the other keys aligned under it */
-        fprintf(out, "%*s- %s:", indent, "", it->keys[0]);
-        write_value(it->items[0], indent + 2, out);
-        for (size_t k = 1; k < it->count; ++k) {
-          fprintf(out, "%*s%s:", indent + 2, "", it->keys[k]);
-          write_value(it->items[k], indent + 2, out);
-        }
-      } else {
-        fprintf(out, "%*s-", indent, "");
-        write_value(it, indent, out);
-      }
-    }
-  } else {
-    fprintf(out, "%*s", indent, "");
-    write_scalar(n, out);
-    fputc('\n', out);
-  }
+  if (n->kind == SPH_NODE_MAP)
+    ok = yaml_mapping_end_event_initialize(&ev);
+  else
+    ok = yaml_sequence_end_event_initialize(&ev);
+  return ok && yaml_emitter_emit(e, &ev);
 }
 
 sph_status sph_node_write(const sph_node *root, FILE *out, sph_error *err) {
-  write_node(root, 0, out);
-  if (ferror(out))
-    return sph_error_set(err, SPH_ERR_IO, "cannot write the scene tree");
-  return SPH_OK;
+  yaml_emitter_t e;
+  if (!yaml_emitter_initialize(&e))
+    return sph_error_set(err, SPH_ERR_NOMEM, "YAML emitter");
+  yaml_emitter_set_output_file(&e, out);
+  yaml_emitter_set_unicode(&e, 1);
+  yaml_emitter_set_indent(&e, 2);
+  yaml_emitter_set_width(&e, -1);
+  yaml_event_t ev;
+  int ok = yaml_stream_start_event_initialize(&ev, YAML_UTF8_ENCODING) &&
+           yaml_emitter_emit(&e, &ev) &&
+           yaml_document_start_event_initialize(&ev, NULL, NULL, NULL, 1) &&
+           yaml_emitter_emit(&e, &ev) && emit_node(&e, root) &&
+           yaml_document_end_event_initialize(&ev, 1) &&
+           yaml_emitter_emit(&e, &ev) &&
+           yaml_stream_end_event_initialize(&ev) &&
+           yaml_emitter_emit(&e, &ev) && yaml_emitter_flush(&e);
+  sph_status st = SPH_OK;
+  if (!ok || ferror(out))
+    st = sph_error_set(err, SPH_ERR_IO, "cannot write the scene tree: %s",
+                       e.problem ? e.problem : "output error");
+  yaml_emitter_delete(&e);
+  return st;
 }
