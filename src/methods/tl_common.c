@@ -85,7 +85,8 @@ static sph_status grow_points(tl_reference *r, size_t need, size_t *cap,
 /* Real points first, then images of every point within two supports of a
  * plane on its domain side; two passes over the planes complete edges,
  * corners and periodic images, duplicates are skipped. */
-static sph_status build_images(tl_reference *r, sph_sim *sim, sph_error *err) {
+static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
+                               sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_particles *ps = sim->ps;
   size_t n = ps->n, cap = 0;
@@ -101,7 +102,7 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, sph_error *err) {
     memset(r->rsign + 3 * a, 1, 3);
     r->ssign[a] = 1;
   }
-  for (size_t k = 0; k < s->nboundaries && np < 32; ++k) {
+  for (size_t k = 0; images && k < s->nboundaries && np < 32; ++k) {
     const sph_boundary *bc = &s->boundaries[k];
     if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
       continue;
@@ -234,14 +235,14 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
   return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
 }
 
-sph_status tl_reference_create(tl_reference *ref, sph_sim *sim,
+sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                sph_error *err) {
   memset(ref, 0, sizeof *ref);
   const sph_scene *s = sim->scene;
   sph_particles *ps = sim->ps;
   int timer = sph_sim_add_timer(sim, "corrections");
   double t0 = sph_wtime();
-  SPH_TRY(build_images(ref, sim, err));
+  SPH_TRY(build_images(ref, sim, images, err));
   size_t n = ref->n, ne = ref->n_ext;
   if (ne > n)
     sim->mirror = &ref->mirror;

@@ -38,8 +38,10 @@ typedef struct tl_reference {
  * "corrections"), with images across the scene's symmetry and
  * skew-symmetry planes in a layer two kernel supports thick, and sets the
  * initial state: x = X, p = rho0 v0, F = I (or the scene reference's
- * initial F), J = det F. */
-sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, sph_error *err);
+ * initial F), J = det F. Without `images` the planes are left to the
+ * method's boundary terms. */
+sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
+                               sph_error *err);
 void tl_reference_destroy(tl_reference *ref);
 
 /* Extra per-point state of n_ext entries (e.g. the cofactor). */

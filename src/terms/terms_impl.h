@@ -46,4 +46,16 @@ sph_status body_force_create(sph_sim *sim, const double *rho0, sph_error *err);
 sph_status essential_bc_create(sph_sim *sim, const double *rho0,
                                sph_error *err);
 
+/* Essential boundary conditions by the Lagrange-multiplier least-squares
+ * projection of seed 000 App. B over the particles of `cloud` (reference
+ * configuration, no mirror images): clamps, rollers, prescribed velocities,
+ * symmetry (normal) and skew-symmetry (tangential) planes constrain the
+ * corrected-kernel interpolant of the momentum at the selected particles;
+ * `global` adds the total momentum rows B.2. */
+struct sph_cloud;
+sph_status lagrange_projection_create(sph_sim *sim,
+                                      const struct sph_cloud *cloud,
+                                      const double *rho0, int global,
+                                      sph_error *err);
+
 #endif

@@ -132,7 +132,7 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
                           "'%s' is not one of: leapfrog", integ);
   const sph_scene *s = sim->scene;
-  SPH_TRY(tl_reference_create(&m->ref, sim, err));
+  SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
   sph_particles *ps = sim->ps;
   m->x = m->ref.x;
   m->p = m->ref.p;

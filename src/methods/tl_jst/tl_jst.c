@@ -221,11 +221,19 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
 }
 
 static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
-  static const char *const keys[] = {
-      "name",         "fields",         "force",
-      "jst",          "jst_projection", "angular_momentum_projection",
-      "laplacian",    "integrator",     "cfl",
-      "essential_bc", "wave_speed",     NULL};
+  static const char *const keys[] = {"name",
+                                     "fields",
+                                     "force",
+                                     "jst",
+                                     "jst_projection",
+                                     "angular_momentum_projection",
+                                     "laplacian",
+                                     "integrator",
+                                     "cfl",
+                                     "essential_bc",
+                                     "wave_speed",
+                                     "lagrange_momentum",
+                                     NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   tl_jst *m = calloc(1, sizeof *m);
   if (!m)
@@ -242,13 +250,20 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                                        "eq31", NULL};
   static const char *const laps[] = {"corrected", "gradient", NULL};
   static const char *const integrators[] = {"tvd-rk2", NULL};
-  static const char *const bcs[] = {"direct", NULL};
+  static const char *const bcs[] = {"direct", "lagrange", NULL};
   int f, fo, lp, integ, bc, amp, jproj;
   SPH_TRY(parse_choice(opt, "fields", fields, "pF", &f, err));
   SPH_TRY(parse_choice(opt, "force", forces, "conservative", &fo, err));
   SPH_TRY(parse_choice(opt, "laplacian", laps, "corrected", &lp, err));
   SPH_TRY(parse_choice(opt, "integrator", integrators, "tvd-rk2", &integ, err));
   SPH_TRY(parse_choice(opt, "essential_bc", bcs, "direct", &bc, err));
+  int lagrange_momentum;
+  SPH_TRY(sph_node_get_bool(opt, "lagrange_momentum", 0, 0, &lagrange_momentum,
+                            err));
+  if (lagrange_momentum && bc != 1)
+    return sph_node_error(sph_node_child(opt, "lagrange_momentum"), err,
+                          SPH_ERR_ARG,
+                          "lagrange_momentum needs essential_bc: lagrange");
   static const char *const speeds[] = {"current", "reference", NULL};
   int ws;
   SPH_TRY(parse_choice(opt, "wave_speed", speeds, "current", &ws, err));
@@ -285,7 +300,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
       return sph_node_error(jst, err, SPH_ERR_RANGE,
                             "JST coefficients must be >= 0");
   /* reference configuration (with mirror images) and the state */
-  SPH_TRY(tl_reference_create(&m->ref, sim, err));
+  SPH_TRY(tl_reference_create(&m->ref, sim, bc == 0, err));
   size_t ne = m->ref.n_ext;
   /* symmetry planes exert forces: the totals the projections zero are not
    * zero there */
@@ -380,13 +395,21 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   }
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (sph_scene_has_essential_bc(s)) {
+  int planes = 0;
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+              s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY;
+  if (bc == 1 && (planes || sph_scene_has_essential_bc(s))) {
+    /* symmetry planes are constraints here, not mirror images */
+    SPH_TRY(lagrange_projection_create(sim, &cloud, m->ref.rho0,
+                                       lagrange_momentum, err));
+    SPH_TRY(tl_jst_constrain(m, 0.0, err));
+  } else if (sph_scene_has_essential_bc(s)) {
     SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
     /* the initial state honours the constraints */
     SPH_TRY(tl_jst_constrain(m, 0.0, err));
   }
   (void)integ;
-  (void)bc;
   return SPH_OK;
 }
 
