@@ -9,6 +9,7 @@ packages=(
   libyaml-dev       # scene files (libyaml document API)
   libmatheval-dev   # expressions in scene files (velocity profiles)
   check             # unit test framework
+  zlib1g-dev        # checkpoint checksums (CRC-32)
   libpng-dev        # PNG frames
   libosmesa6-dev    # off-screen OpenGL renderer
   libfreetype-dev fonts-dejavu-core  # text on frames

@@ -211,4 +211,7 @@ int sph_scene_find_body(const sph_scene *s, const char *name);
 int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
                            int body, const double X[3]);
 
+/* Physical time of output frame `index`: min(time.end, index * every). */
+double sph_output_time(const sph_scene *s, int index);
+
 #endif

@@ -55,6 +55,14 @@ struct sph_term {
   unsigned long calls;
 };
 
+/* A named state array of a method (checkpoints save and restore these). */
+typedef struct sph_state_array {
+  const char *name;
+  double *data;
+  size_t len;
+} sph_state_array;
+#define SPH_MAX_STATE 8
+
 typedef struct sph_method_ops {
   const char *name;      /* scene name, e.g. "tl-jst" */
   const char *title;     /* readable name */
@@ -68,6 +76,9 @@ typedef struct sph_method_ops {
   sph_status (*derive)(sph_sim *sim, sph_error *err);
   /* kinetic and stored (strain) energy of the current state */
   void (*energy)(sph_sim *sim, double *kinetic, double *strain);
+  /* the arrays that, with the time, determine every later step; returns
+   * their count (at most SPH_MAX_STATE) */
+  int (*state)(sph_sim *sim, sph_state_array *out);
   void (*destroy)(sph_sim *sim);
 } sph_method_ops;
 

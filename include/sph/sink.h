@@ -24,6 +24,9 @@ typedef struct sph_sink_ops {
   sph_status (*open)(sph_sink *sink, const sph_sim *sim, const char *dir,
                      sph_error *err);
   sph_status (*write)(sph_sink *sink, const sph_frame *frame, sph_error *err);
+  /* makes what was written so far durable (before a checkpoint; may be
+   * NULL) */
+  sph_status (*flush)(sph_sink *sink, sph_error *err);
   /* completes the files (renames them into place) */
   sph_status (*close)(sph_sink *sink, sph_error *err);
   void (*destroy)(sph_sink *sink);
@@ -32,6 +35,9 @@ typedef struct sph_sink_ops {
 struct sph_sink {
   const sph_sink_ops *ops;
   void *data;
+  /* > 0 when resuming: frames 0 .. resume_frames - 1 exist already and the
+   * sink continues after them */
+  int resume_frames;
 };
 
 /* energy.csv: time, energies, linear and angular momentum */
@@ -51,6 +57,13 @@ typedef struct sph_atomic_file {
 sph_status sph_atomic_open(sph_atomic_file *af, const char *path,
                            sph_error *err);
 sph_status sph_atomic_commit(sph_atomic_file *af, sph_error *err);
+/* As sph_atomic_open, starting the new file with the first `lines` lines
+ * of the earlier <path> (or of its temporary file, if the run that wrote
+ * it was killed); fails if it has fewer. */
+sph_status sph_atomic_open_keep(sph_atomic_file *af, const char *path,
+                                size_t lines, sph_error *err);
+/* Flushes and fsyncs the temporary file. */
+sph_status sph_atomic_flush(sph_atomic_file *af, sph_error *err);
 /* Closes and removes the temporary file (safe after a failed commit). */
 void sph_atomic_abort(sph_atomic_file *af);
 

@@ -19,10 +19,11 @@ typedef struct sph_app_args {
   const char *scene;              /* path (default scene when NULL) */
   const char *sets[SPH_MAX_SETS]; /* --set k=v */
   size_t nsets;
-  const char *out; /* --out DIR */
-  int threads;     /* --threads N (0 = OpenMP default) */
-  int overwrite;   /* --overwrite */
-  int quiet;       /* --quiet */
+  const char *out;    /* --out DIR */
+  const char *resume; /* --resume DIR */
+  int threads;        /* --threads N (0 = OpenMP default) */
+  int overwrite;      /* --overwrite */
+  int quiet;          /* --quiet */
 } sph_app_args;
 
 /* Parses argv[first..] into args; prints usage errors; returns 0 or 2. */

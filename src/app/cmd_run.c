@@ -13,6 +13,7 @@
 
 #include "app/app_impl.h"
 #include "app/progress_impl.h"
+#include "sph/checkpoint.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
 #include "sph/sink.h"
@@ -40,8 +41,10 @@ static int file_exists(const char *dir, const char *name) {
 
 /* Removes only the files an earlier run of ours wrote. */
 static void remove_previous(const char *dir) {
-  static const char *const names[] = {"summary.json", "energy.csv",
-                                      "probes.csv", "scene_used.yaml", NULL};
+  static const char *const names[] = {
+      "summary.json",    "energy.csv",        "probes.csv",
+      "scene_used.yaml", SPH_CHECKPOINT_FILE, SPH_CHECKPOINT_PREVIOUS,
+      "energy.csv.part", "probes.csv.part",   NULL};
   char path[1200];
   for (const char *const *n = names; *n; ++n) {
     snprintf(path, sizeof path, "%s/%s", dir, *n);
@@ -129,13 +132,22 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error_clear(&err);
   sph_status st = SPH_OK;
   char dir[1024];
-  if (args.out)
+  if (args.resume && args.out && strcmp(args.resume, args.out)) {
+    fprintf(stderr, "sph: --resume continues in its own folder; drop --out "
+                    "or give the same folder\n");
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
+  if (args.resume)
+    snprintf(dir, sizeof dir, "%s", args.resume);
+  else if (args.out)
     snprintf(dir, sizeof dir, "%s", args.out);
   else
     snprintf(dir, sizeof dir, "outputs/%s", scene->name);
   if ((file_exists(dir, "summary.json") ||
        file_exists(dir, "scene_used.yaml")) &&
-      !args.overwrite) {
+      !args.overwrite && !args.resume) {
     fprintf(stderr,
             "sph: %s holds the results of an earlier run; pass --overwrite "
             "to replace them or --out DIR to write elsewhere\n",
@@ -151,7 +163,7 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  if (args.overwrite)
+  if (args.overwrite && !args.resume)
     remove_previous(dir);
   if (!args.quiet)
     banner(sim, dir);
@@ -164,22 +176,42 @@ int sph_cmd_run(int argc, char **argv) {
   if (scene->output.nprobes)
     sinks[nsinks++] = (sph_sink){.ops = &sph_probe_sink_ops};
   sph_verdict *verdict = NULL;
-  st = write_scene_used(scene, dir, &err);
+  int index = 0;
+  st = sph_verdict_create(&verdict, sim, &err);
+  if (st == SPH_OK && args.resume) {
+    char used[1200];
+    st = sph_checkpoint_resume(dir, sim, verdict, &index, used, sizeof used,
+                               &err);
+    if (st != SPH_OK) {
+      sph_app_print_error(&err);
+      sph_verdict_destroy(verdict);
+      sph_sim_destroy(sim);
+      sph_scene_destroy(scene);
+      return SPH_EXIT_USAGE;
+    }
+    if (!args.quiet)
+      printf("  resume     %s: t = %.6g s, step %lu, next output %d\n", used,
+             sim->t, sim->steps, index);
+  }
   if (st == SPH_OK)
-    st = sph_verdict_create(&verdict, sim, &err);
-  for (int i = 0; i < nsinks && st == SPH_OK; ++i)
+    st = write_scene_used(scene, dir, &err);
+  for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+    sinks[i].resume_frames = index;
     st = sinks[i].ops->open(&sinks[i], sim, dir, &err);
+  }
 
   sph_progress prog;
   sph_progress_start(&prog, scene->t_end, args.quiet);
   double wall0 = sph_wtime();
-  int completed = 0, index = 0;
-  if (st == SPH_OK)
+  int completed = 0;
+  if (st == SPH_OK && index == 0)
     st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
-  double t_end = scene->t_end, every = scene->output.every;
+  double t_end = scene->t_end, ckpt = scene->output.checkpoint_every;
   double eps = 1e-12 * t_end;
+  double next_ckpt =
+      ckpt > 0.0 ? ckpt * (floor(sim->t / ckpt + 1e-9) + 1.0) : INFINITY;
   while (st == SPH_OK && verdict->stable && sim->t < t_end - eps) {
-    double next = fmin(t_end, every * (double)index);
+    double next = sph_output_time(scene, index);
     st = sph_sim_step(sim, next - sim->t, &err);
     if (st != SPH_OK)
       break;
@@ -188,6 +220,15 @@ int sph_cmd_run(int argc, char **argv) {
       sim->t = next; /* land exactly on the output time */
       st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
       sph_progress_output(&prog, sim->t, sim->steps);
+    }
+    if (st == SPH_OK && sim->t >= next_ckpt - eps && sim->t < t_end - eps) {
+      /* rows before the checkpoint reach the disk first */
+      for (int i = 0; i < nsinks && st == SPH_OK; ++i)
+        if (sinks[i].ops->flush)
+          st = sinks[i].ops->flush(&sinks[i], &err);
+      if (st == SPH_OK)
+        st = sph_checkpoint_write(dir, sim, verdict, index, &err);
+      next_ckpt += ckpt * floor((sim->t - next_ckpt) / ckpt + 1.0);
     }
   }
   sph_progress_finish(&prog);

@@ -15,6 +15,8 @@ static void usage(FILE *out) {
                "commands:\n"
                "  run [SCENE] [--set k=v]... [--out DIR] [--threads N] "
                "[--overwrite] [--quiet]\n"
+               "      [--resume DIR]   continue a killed run from its newest "
+               "checkpoint\n"
                "                       simulate a scene (default: the twisting "
                "column)\n"
                "  check SCENE [--set k=v]...\n"
@@ -47,8 +49,8 @@ int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
   for (int i = first; i < argc; ++i) {
     const char *a = argv[i];
     const char *val = NULL;
-    int takes =
-        !strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--threads");
+    int takes = !strcmp(a, "--set") || !strcmp(a, "--out") ||
+                !strcmp(a, "--threads") || !strcmp(a, "--resume");
     if (takes) {
       if (i + 1 >= argc) {
         fprintf(stderr, "sph %s: %s needs a value\n", command, a);
@@ -65,6 +67,8 @@ int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
       args->sets[args->nsets++] = val;
     } else if (!strcmp(a, "--out")) {
       args->out = val;
+    } else if (!strcmp(a, "--resume")) {
+      args->resume = val;
     } else if (!strcmp(a, "--threads")) {
       char *end;
       long n = strtol(val, &end, 10);

@@ -2,6 +2,7 @@
  * so a killed run never leaves a truncated file under the final name. */
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -43,4 +44,54 @@ void sph_atomic_abort(sph_atomic_file *af) {
   af->f = NULL;
   if (af->tmp[0])
     remove(af->tmp);
+}
+
+sph_status sph_atomic_open_keep(sph_atomic_file *af, const char *path,
+                                size_t lines, sph_error *err) {
+  char tmp[1040];
+  snprintf(tmp, sizeof tmp, "%s.part", path);
+  FILE *f = fopen(path, "r");
+  if (!f)
+    f = fopen(tmp, "r");
+  if (!f)
+    return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
+                        "cannot resume: neither the file nor its .part "
+                        "exists");
+  char *buf = NULL;
+  size_t cap = 0, len = 0, have = 0;
+  for (int ch; have < lines && (ch = fgetc(f)) != EOF;) {
+    if (len + 1 >= cap) {
+      cap = cap ? 2 * cap : 65536;
+      char *nb = realloc(buf, cap);
+      if (!nb) {
+        free(buf);
+        fclose(f);
+        return sph_error_set(err, SPH_ERR_NOMEM, "resume %s", path);
+      }
+      buf = nb;
+    }
+    buf[len++] = (char)ch;
+    have += ch == '\n';
+  }
+  fclose(f);
+  if (have < lines) {
+    free(buf);
+    return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
+                        "cannot resume: %zu complete lines, the checkpoint "
+                        "needs %zu",
+                        have, lines);
+  }
+  sph_status st = sph_atomic_open(af, path, err);
+  if (st == SPH_OK && len)
+    fwrite(buf, 1, len, af->f);
+  free(buf);
+  return st;
+}
+
+sph_status sph_atomic_flush(sph_atomic_file *af, sph_error *err) {
+  if (!af->f || fflush(af->f) != 0 || ferror(af->f) ||
+      fsync(fileno(af->f)) != 0)
+    return sph_error_at(err, SPH_ERR_IO, af->path, 0, 0, NULL,
+                        "cannot write the file: %s", strerror(errno));
+  return SPH_OK;
 }

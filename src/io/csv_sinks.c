@@ -14,6 +14,22 @@ static sph_status csv_close(sph_sink *sink, sph_error *err) {
   return sph_atomic_commit(af, err);
 }
 
+static sph_status csv_flush(sph_sink *sink, sph_error *err) {
+  return sph_atomic_flush(sink->data, err);
+}
+
+/* Opens <dir>/<name>: fresh with `header`, or keeping the header and the
+ * rows of the frames a resumed run already has. */
+static sph_status csv_open(sph_sink *sink, sph_atomic_file *af, const char *dir,
+                           const char *name, int *fresh, sph_error *err) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  *fresh = sink->resume_frames <= 0;
+  if (*fresh)
+    return sph_atomic_open(af, path, err);
+  return sph_atomic_open_keep(af, path, 1 + (size_t)sink->resume_frames, err);
+}
+
 static void csv_destroy(sph_sink *sink) {
   sph_atomic_file *af = sink->data;
   if (!af)
@@ -32,10 +48,9 @@ static sph_status energy_open(sph_sink *sink, const sph_sim *sim,
   if (!af)
     return sph_error_set(err, SPH_ERR_NOMEM, "energy sink");
   sink->data = af;
-  char path[1024];
-  snprintf(path, sizeof path, "%s/energy.csv", dir);
-  sph_status st = sph_atomic_open(af, path, err);
-  if (st == SPH_OK)
+  int fresh;
+  sph_status st = csv_open(sink, af, dir, "energy.csv", &fresh, err);
+  if (st == SPH_OK && fresh)
     fprintf(af->f, "time,kinetic,strain,total,linear_momentum_x,"
                    "linear_momentum_y,linear_momentum_z,angular_momentum_x,"
                    "angular_momentum_y,angular_momentum_z\n");
@@ -60,6 +75,7 @@ const sph_sink_ops sph_energy_sink_ops = {
     .name = "energy.csv",
     .open = energy_open,
     .write = energy_write,
+    .flush = csv_flush,
     .close = csv_close,
     .destroy = csv_destroy,
 };
@@ -95,10 +111,9 @@ static sph_status probe_open(sph_sink *sink, const sph_sim *sim,
       }
     }
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/probes.csv", dir);
-  sph_status st = sph_atomic_open(&p->af, path, err);
-  if (st != SPH_OK)
+  int fresh;
+  sph_status st = csv_open(sink, &p->af, dir, "probes.csv", &fresh, err);
+  if (st != SPH_OK || !fresh)
     return st;
   static const char *const comp3[] = {"_x", "_y", "_z"};
   static const char *const comp9[] = {"_xx", "_xy", "_xz", "_yx", "_yy",
@@ -156,6 +171,7 @@ const sph_sink_ops sph_probe_sink_ops = {
     .name = "probes.csv",
     .open = probe_open,
     .write = probe_write,
+    .flush = csv_flush,
     .close = csv_close,
     .destroy = probe_destroy,
 };

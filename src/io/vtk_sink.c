@@ -49,6 +49,9 @@ static sph_status vtk_open(sph_sink *sink, const sph_sim *sim, const char *dir,
   v->ids = malloc((v->n ? v->n : 1) * sizeof *v->ids);
   if (!v->times || !v->ids)
     return sph_error_set(err, SPH_ERR_NOMEM, "vtk sink");
+  /* resuming: the frames before the checkpoint are on disk */
+  for (int i = 0; i < sink->resume_frames && i < v->cap; ++i)
+    v->times[v->nframes++] = sph_output_time(sim->scene, i);
   return SPH_OK;
 }
 

@@ -269,6 +269,9 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                    SPH_FIELD_VON_MISES, SPH_FIELD_MASS};
   for (size_t i = 0; i < sizeof need / sizeof *need; ++i)
     SPH_TRY(sph_particles_require(ps, need[i], err));
+  for (int i = 0; i < s->output.nfields; ++i)
+    if (s->output.fields[i] == SPH_FIELD_ACCELERATION)
+      SPH_TRY(sph_particles_require(ps, SPH_FIELD_ACCELERATION, err));
   ref->owns_state = ne > n;
   if (ref->owns_state) {
     SPH_TRY(tl_reference_alloc(ref, 3, &ref->x, err));
@@ -510,4 +513,13 @@ void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
   *kinetic = ek;
   *strain = es;
   (void)sim;
+}
+
+void tl_acceleration(sph_sim *sim, const tl_reference *ref, const double *dp) {
+  double *acc = sim->ps->field[SPH_FIELD_ACCELERATION];
+  long n = (long)ref->n;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c)
+      acc[3 * a + c] = dp[3 * a + c] / ref->rho0[a];
 }

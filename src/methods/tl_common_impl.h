@@ -76,6 +76,10 @@ double tl_stable_dt(const tl_reference *ref, const sph_sim *sim, double cfl,
  * not finite. */
 sph_status tl_check_finite(const tl_reference *ref, sph_error *err);
 
+/* The acceleration output field, dp / rho0, from the rates of the current
+ * state (only when the scene asks for it). */
+void tl_acceleration(sph_sim *sim, const tl_reference *ref, const double *dp);
+
 /* Kinetic and strain energy of the real particles; H and J may be NULL. */
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,
                const double *J, double *kinetic, double *strain);

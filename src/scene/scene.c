@@ -955,6 +955,10 @@ int sph_scene_has_essential_bc(const sph_scene *s) {
   return 0;
 }
 
+double sph_output_time(const sph_scene *s, int index) {
+  return fmin(s->t_end, s->output.every * (double)index);
+}
+
 double sph_scene_min_spacing(const sph_scene *s) {
   double dp = INFINITY;
   for (size_t b = 0; b < s->nbodies; ++b)

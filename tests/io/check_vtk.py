@@ -5,7 +5,9 @@ present; every .vtp reads without a VTK error or warning (each in its own
 process: a malformed header can abort the reader); point counts, array
 names and component counts; binary and ASCII runs hold identical values;
 points equal initial_position + displacement; the probe particle's values
-equal probes.csv. Usage: check_vtk.py BINARY_DIR ASCII_DIR SCENE_NAME"""
+equal probes.csv. Usage: check_vtk.py BINARY_DIR ASCII_DIR SCENE_NAME
+or check_vtk.py --series DIR SCENE_NAME: the .pvd and every file it lists
+read cleanly with the same point count (e.g. after a killed run)."""
 import csv
 import os
 import subprocess
@@ -14,7 +16,7 @@ import xml.etree.ElementTree as ET
 
 EXPECTED = {"pressure": 1, "velocity": 3, "displacement": 3,
             "initial_position": 3, "J": 1, "stress": 9, "body_id": 1,
-            "particle_id": 1}
+            "particle_id": 1, "acceleration": 3}
 
 
 def read_one(path):
@@ -133,8 +135,25 @@ def main():
     sys.exit(1 if failures else 0)
 
 
+def series():
+    d, name = sys.argv[2:4]
+    _, files = frames(d, name)
+    counts = set()
+    for path in files:
+        r = read(path)
+        if r is not None:
+            counts.add(r["npoints"])
+    if len(counts) > 1:
+        fail("frames hold different point counts %s" % counts)
+    print("%d frames of %s read cleanly, %d problems" %
+          (len(files), d, failures))
+    sys.exit(1 if failures or not files else 0)
+
+
 if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--one":
         read_one(sys.argv[2])
+    elif len(sys.argv) == 4 and sys.argv[1] == "--series":
+        series()
     else:
         main()

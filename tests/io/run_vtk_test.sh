@@ -8,7 +8,7 @@ src=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 common=(--quiet --set 'bodies.0.particles.count=[3,7,3]' --set time.end=0.02
-  --set 'output.fields=[pressure,velocity,displacement,initial_position,J,stress,body_id,particle_id]')
+  --set 'output.fields=[pressure,velocity,displacement,initial_position,J,stress,body_id,particle_id,acceleration]')
 "$sph" run "$src/scenes/twisting_column.yaml" --out "$work/bin" "${common[@]}" >/dev/null || exit 1
 "$sph" run "$src/scenes/twisting_column.yaml" --out "$work/ascii" "${common[@]}" \
   --set output.vtk.format=ascii >/dev/null || exit 1

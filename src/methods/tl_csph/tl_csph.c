@@ -89,6 +89,11 @@ static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
   deformation_and_stress(m, (long)sim->ps->n);
   tl_derive(sim, &m->ref, NULL, NULL);
+  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
+    if (!m->lf.have_rates)
+      SPH_TRY(m->lf.rates(m->lf.ctx, sim->t, err));
+    tl_acceleration(sim, &m->ref, m->dp);
+  }
   return SPH_OK;
 }
 
@@ -159,6 +164,16 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   return SPH_OK;
 }
 
+static int tl_csph_state(sph_sim *sim, sph_state_array *out) {
+  tl_csph *m = sim->method_data;
+  size_t n = m->ref.n;
+  out[0] = (sph_state_array){"x", m->x, 3 * n};
+  out[1] = (sph_state_array){"p", m->p, 3 * n};
+  /* F of the last rates: the next time step's wave speed reads it */
+  out[2] = (sph_state_array){"F", m->F, 9 * n};
+  return 3;
+}
+
 const sph_method_ops tl_csph_method_ops = {
     .name = "tl-csph",
     .title = "Total-Lagrangian corrected SPH, displacement-based (baseline)",
@@ -168,5 +183,6 @@ const sph_method_ops tl_csph_method_ops = {
     .step = tl_csph_step,
     .derive = tl_csph_derive,
     .energy = tl_csph_energy,
+    .state = tl_csph_state,
     .destroy = tl_csph_destroy,
 };

@@ -161,6 +161,11 @@ static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   compute_stress(m, (long)m->ref.n_ext);
   tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
             m->fields == TL_JST_PF ? NULL : m->J);
+  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
+    /* the rates are scratch between steps */
+    SPH_TRY(tl_jst_rhs(m, 0, sim->t, 0.0, err));
+    tl_acceleration(sim, &m->ref, m->dp);
+  }
   return SPH_OK;
 }
 
@@ -413,6 +418,18 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   return SPH_OK;
 }
 
+static int tl_jst_state(sph_sim *sim, sph_state_array *out) {
+  tl_jst *m = sim->method_data;
+  static const char *const names[] = {"x", "p", "F", "H", "J"};
+  const double *y[5] = {m->x, m->p, m->F, m->H, m->J};
+  int k = 0;
+  for (int v = 0; v < m->ode.nvec; ++v)
+    for (int i = 0; i < 5; ++i)
+      if (m->ode.y[v] == y[i])
+        out[k++] = (sph_state_array){names[i], m->ode.y[v], m->ode.len[v]};
+  return k;
+}
+
 const sph_method_ops tl_jst_method_ops = {
     .name = "tl-jst",
     .title = "Total-Lagrangian JST-SPH, mixed {p,F}/{p,F,J}/{p,F,H,J}",
@@ -423,5 +440,6 @@ const sph_method_ops tl_jst_method_ops = {
     .step = tl_jst_step,
     .derive = tl_jst_derive,
     .energy = tl_jst_energy,
+    .state = tl_jst_state,
     .destroy = tl_jst_destroy,
 };

@@ -1,0 +1,45 @@
+/* Checkpoints (DESIGN.md sec. 7): a versioned binary snapshot of what
+ * determines every later step of a run, so `sph run --resume DIR` continues
+ * exactly where a killed run left off.
+ *
+ * Layout (little-endian, version 1):
+ *   "SPHCKPT\0"  u32 version  u32 endianness tag 0x01020304
+ *   u64 particles  char method[32]  char scene[64]  u32 scene_crc
+ *   f64 t  u64 steps  f64 dt_min dt_max dt_last  i32 next_output
+ *   the verdict (its scalars)  u32 narrays
+ *   narrays x (char name[16], u64 length)
+ *   the arrays' f64 data
+ *   u32 crc32 of everything before it (zlib)
+ * A file is accepted only when every field matches the simulation it is
+ * loaded into and the checksum holds; nothing is changed otherwise. */
+#ifndef SPH_CHECKPOINT_H
+#define SPH_CHECKPOINT_H
+
+#include "sph/sim.h"
+#include "sph/stability.h"
+#include "sph/status.h"
+
+#define SPH_CHECKPOINT_VERSION 1u
+#define SPH_CHECKPOINT_FILE "checkpoint.sphc"
+#define SPH_CHECKPOINT_PREVIOUS "checkpoint.prev.sphc"
+
+/* CRC-32 of the resolved scene (every default filled in): a checkpoint
+ * resumes only the configuration that wrote it. */
+sph_status sph_checkpoint_scene_crc(const sph_scene *s, unsigned *crc,
+                                    sph_error *err);
+
+/* Writes DIR/checkpoint.sphc atomically, keeping the one before as
+ * checkpoint.prev.sphc. */
+sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
+                                const sph_verdict *v, int next_output,
+                                sph_error *err);
+
+/* Loads the newest valid checkpoint of DIR into sim and v (method state,
+ * time, step counters, verdict); *next_output receives the index of the
+ * next output frame and `used` the file's path. Fails naming every
+ * candidate's defect when none is valid. */
+sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
+                                 int *next_output, char *used, size_t used_len,
+                                 sph_error *err);
+
+#endif
