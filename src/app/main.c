@@ -23,6 +23,11 @@ static void usage(FILE *out) {
                "                       validate a scene and print what will be "
                "simulated\n"
                "  list                 list the shipped scenes\n"
+               "  imgdiff A.png B.png [--tolerance N] [--shift N] "
+               "[--max-fraction F]\n"
+               "          [--max-cluster N] [--diff OUT.png]\n"
+               "                       compare two images (exit 0 same, 1 "
+               "different)\n"
                "  help                 this text\n");
 }
 
@@ -125,6 +130,8 @@ int main(int argc, char **argv) {
     return sph_cmd_check(argc, argv);
   if (!strcmp(cmd, "list"))
     return sph_cmd_list(argc, argv);
+  if (!strcmp(cmd, "imgdiff"))
+    return sph_cmd_imgdiff(argc, argv);
   if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
     usage(stdout);
     return SPH_EXIT_OK;
