@@ -14,6 +14,7 @@
 #include "app/app_impl.h"
 #include "app/progress_impl.h"
 #include "sph/checkpoint.h"
+#include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
 #include "sph/sink.h"
@@ -168,13 +169,15 @@ int sph_cmd_run(int argc, char **argv) {
   if (!args.quiet)
     banner(sim, dir);
 
-  sph_sink sinks[3];
+  sph_sink sinks[4];
   int nsinks = 0;
   sinks[nsinks++] = (sph_sink){.ops = &sph_energy_sink_ops};
   if (scene->output.vtk)
     sinks[nsinks++] = (sph_sink){.ops = &sph_vtk_sink_ops};
   if (scene->output.nprobes)
     sinks[nsinks++] = (sph_sink){.ops = &sph_probe_sink_ops};
+  if (scene->output.png.enabled)
+    sinks[nsinks++] = (sph_sink){.ops = &sph_png_sink_ops};
   sph_verdict *verdict = NULL;
   int index = 0;
   st = sph_verdict_create(&verdict, sim, &err);
