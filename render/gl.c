@@ -17,7 +17,7 @@
 /* Vertex stage: one instance per sphere, the unit quad corner expanded in
  * eye space around the centre. Perspective quads face the eye and have the
  * half size of the tangent cone's circle in the plane of the centre, so the
- * silhouette is inscribed exactly; ortho quads are r x r squares. */
+ * silhouette is inscribed exactly; ortho quads are 2r x 2r squares. */
 static const char *const vertex_src =
     "#version 330 core\n"
     "layout(location = 0) in vec2 corner;\n"
@@ -422,6 +422,10 @@ sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
       if (!isfinite(clip_plane[k]))
         return sph_error_set(err, SPH_ERR_ARG, "render: non-finite clip plane");
   SPH_TRY(sph_view_check(view, err));
+  for (size_t i = 0; i < 3 * n; ++i)
+    if (!isfinite(xyz[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "render: sphere %zu has a non-finite centre", i / 3);
   if (n > (size_t)INT_MAX)
     return sph_error_set(err, SPH_ERR_RANGE,
                          "render: %zu spheres exceed one draw call", n);

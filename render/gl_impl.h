@@ -81,7 +81,10 @@ typedef struct sph_gl sph_gl;
  * SPH_ERR_UNSUPPORTED when OSMesa cannot give a 3.3 core context or the
  * shaders do not build (the compile/link log is in the message);
  * SPH_ERR_RANGE when the size exceeds the driver's limits. The context is
- * made current on the calling thread; use one sph_gl per thread. */
+ * made current on the calling thread; use one sph_gl per thread and keep
+ * it for many frames (Mesa keeps about 200 bytes per context it ever made
+ * current). The first call may set GALLIUM_DRIVER (setenv), so make it
+ * before other threads read the environment. */
 sph_status sph_gl_create(int width, int height, sph_gl **out, sph_error *err);
 
 /* Draws n spheres of common radius (world units) into img and returns the
@@ -93,7 +96,8 @@ sph_status sph_gl_create(int width, int height, sph_gl **out, sph_error *err);
  * bytes (the caller owns it). GPU buffers are kept and grown between calls.
  * Spheres crossing the near or far plane are cut there (possibly whole:
  * no inside surface is shown); a sphere that contains the eye is not drawn.
- * n = 0 gives the background. */
+ * n = 0 gives the background. SPH_ERR_NUMERIC for a non-finite centre,
+ * SPH_ERR_ARG for a bad camera, radius or image. */
 sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
                                const float *xyz, float radius,
                                const unsigned char *rgb,

@@ -1,8 +1,8 @@
 /* OSMesa sphere renderer: disc size and shading of one sphere (ortho and
  * perspective, also 400 px wide), top-first rows, depth-correct occlusion in
  * either draw order, the clip plane, byte-identical repeat frames, the
- * camera fit, argument errors; writes gl_demo_lattice.ppm to the build
- * directory. */
+ * camera fit, argument errors and the refused swrast driver; writes
+ * gl_demo_lattice.ppm to the build directory. */
 #include "test_util.h"
 
 #include <math.h>
@@ -365,6 +365,11 @@ START_TEST(arguments) {
   ck_assert_int_eq(
       sph_gl_draw_spheres(gl, &bad, 1, c, 0.5f, col, NULL, &img, &err),
       SPH_ERR_ARG);
+  const float nan_xyz[6] = {0, 0, 0, 1, NAN, 0};
+  const unsigned char two[6] = {1, 2, 3, 4, 5, 6};
+  ck_assert_int_eq(
+      sph_gl_draw_spheres(gl, &v, 2, nan_xyz, 0.5f, two, NULL, &img, &err),
+      SPH_ERR_NUMERIC);
   /* no spheres: background only */
   draw(gl, &v, 0, NULL, 0.0f, NULL, NULL, &img);
   int bg = 0;
@@ -378,6 +383,12 @@ START_TEST(arguments) {
   ck_assert_ptr_null(none);
   ck_assert_int_eq(sph_gl_create(100000, 10, &none, &err), SPH_ERR_RANGE);
   ck_assert_ptr_null(none);
+  /* the driver that crashes OSMesa is refused with a clear message */
+  ck_assert_int_eq(setenv("GALLIUM_DRIVER", "swrast", 1), 0);
+  ck_assert_int_eq(sph_gl_create(10, 10, &none, &err), SPH_ERR_UNSUPPORTED);
+  ck_assert_ptr_null(none);
+  ck_assert_ptr_nonnull(strstr(err.message, "swrast"));
+  ck_assert_int_eq(setenv("GALLIUM_DRIVER", "llvmpipe", 1), 0);
   sph_gl_destroy(gl);
   free(img.rgba);
   free(wrong.rgba);
