@@ -55,6 +55,20 @@ typedef struct header {
   int32_t next_output;
 } header;
 
+/* The header's fields after magic, version and byte-order tag, in file
+ * order: one list for writing and reading. */
+#define HEADER_FIELD(f)                                                        \
+  { offsetof(header, f), sizeof(((header *)0)->f) }
+static const struct {
+  size_t off, size;
+} header_fields[] = {
+    HEADER_FIELD(particles),   HEADER_FIELD(method), HEADER_FIELD(scene),
+    HEADER_FIELD(scene_crc),   HEADER_FIELD(t),      HEADER_FIELD(steps),
+    HEADER_FIELD(dt_min),      HEADER_FIELD(dt_max), HEADER_FIELD(dt_last),
+    HEADER_FIELD(next_output),
+};
+#define NHEADER (sizeof header_fields / sizeof *header_fields)
+
 sph_status sph_checkpoint_scene_crc(const sph_scene *s, unsigned *crc,
                                     sph_error *err) {
   char *buf = NULL;
@@ -104,16 +118,8 @@ static void put_header(writer *w, const header *h) {
   put(w, magic, sizeof magic);
   put(w, &version, 4);
   put(w, &endian_tag, 4);
-  put(w, &h->particles, 8);
-  put(w, h->method, sizeof h->method);
-  put(w, h->scene, sizeof h->scene);
-  put(w, &h->scene_crc, 4);
-  put(w, &h->t, 8);
-  put(w, &h->steps, 8);
-  put(w, &h->dt_min, 8);
-  put(w, &h->dt_max, 8);
-  put(w, &h->dt_last, 8);
-  put(w, &h->next_output, 4);
+  for (size_t i = 0; i < NHEADER; ++i)
+    put(w, (const char *)h + header_fields[i].off, header_fields[i].size);
 }
 
 sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
@@ -228,14 +234,11 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
          SPH_CHECKPOINT_VERSION);
   if (tag != endian_tag)
     FAIL("written on a machine of the other byte order");
-  if (!get(&r, &h.particles, 8) || !get(&r, h.method, sizeof h.method) ||
-      !get(&r, h.scene, sizeof h.scene) || !get(&r, &h.scene_crc, 4) ||
-      !get(&r, &h.t, 8) || !get(&r, &h.steps, 8) || !get(&r, &h.dt_min, 8) ||
-      !get(&r, &h.dt_max, 8) || !get(&r, &h.dt_last, 8) ||
-      !get(&r, &h.next_output, 4))
-    FAIL("truncated header");
+  for (size_t i = 0; i < NHEADER; ++i)
+    if (!get(&r, (char *)&h + header_fields[i].off, header_fields[i].size))
+      FAIL("truncated header");
   h.method[sizeof h.method - 1] = h.scene[sizeof h.scene - 1] = '\0';
-  unsigned crc;
+  unsigned crc = 0;
   if ((st = sph_checkpoint_scene_crc(sim->scene, &crc, err)) != SPH_OK)
     goto done;
   if (strcmp(h.scene, sim->scene->name))
