@@ -61,12 +61,13 @@ typedef struct sph_state_array {
   double *data;
   size_t len;
 } sph_state_array;
-#define SPH_MAX_STATE 8
+#define SPH_MAX_STATE 12
 
 typedef struct sph_method_ops {
-  const char *name;      /* scene name, e.g. "tl-jst" */
-  const char *title;     /* readable name */
-  const char *reference; /* seed sections and equations */
+  const char *name;               /* scene name, e.g. "tl-jst" */
+  const char *title;              /* readable name */
+  const char *reference;          /* seed sections and equations */
+  int conserves_angular_momentum; /* to round-off, for a free body */
   /* validates the method block, requires fields, creates its terms */
   sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);
   double (*stable_dt)(sph_sim *sim);
@@ -79,6 +80,9 @@ typedef struct sph_method_ops {
   /* the arrays that, with the time, determine every later step; returns
    * their count (at most SPH_MAX_STATE) */
   int (*state)(sph_sim *sim, sph_state_array *out);
+  /* rebuilds what the method derives from its state arrays after a
+   * checkpoint has overwritten them (may be NULL) */
+  sph_status (*restore)(sph_sim *sim, sph_error *err);
   void (*destroy)(sph_sim *sim);
 } sph_method_ops;
 

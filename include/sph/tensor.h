@@ -149,4 +149,47 @@ static inline double sph_mat3_norm1(const double A[9]) {
   return best;
 }
 
+/* Eigen-decomposition of a symmetric A = Q diag(w) Q^T by cyclic Jacobi
+ * rotations (columns of Q are the eigenvectors, row-major storage). */
+static inline void sph_mat3_sym_eigen(const double A[9], double w[3],
+                                      double Q[9]) {
+  double a[9];
+  memcpy(a, A, sizeof a);
+  sph_mat3_identity(Q);
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    double off = a[1] * a[1] + a[2] * a[2] + a[5] * a[5];
+    if (off <= 1e-30 * (a[0] * a[0] + a[4] * a[4] + a[8] * a[8]) || off == 0.0)
+      break;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        double apq = a[3 * p + q];
+        if (apq == 0.0)
+          continue;
+        double theta = (a[3 * q + q] - a[3 * p + p]) / (2.0 * apq);
+        double t = (theta >= 0 ? 1.0 : -1.0) /
+                   (fabs(theta) + sqrt(theta * theta + 1.0));
+        double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+        /* a <- R^T a R, Q <- Q R with R the (p, q) rotation */
+        for (int k = 0; k < 3; ++k) {
+          double akp = a[3 * k + p], akq = a[3 * k + q];
+          a[3 * k + p] = c * akp - s * akq;
+          a[3 * k + q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < 3; ++k) {
+          double apk = a[3 * p + k], aqk = a[3 * q + k];
+          a[3 * p + k] = c * apk - s * aqk;
+          a[3 * q + k] = s * apk + c * aqk;
+        }
+        for (int k = 0; k < 3; ++k) {
+          double qkp = Q[3 * k + p], qkq = Q[3 * k + q];
+          Q[3 * k + p] = c * qkp - s * qkq;
+          Q[3 * k + q] = s * qkp + c * qkq;
+        }
+      }
+  }
+  w[0] = a[0];
+  w[1] = a[4];
+  w[2] = a[8];
+}
+
 #endif

@@ -282,6 +282,8 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
   /* everything checked: copy in */
   for (int i = 0; i < nm; ++i)
     get(&r, arr[i].data, arr[i].len * sizeof(double));
+  if (sim->method->restore && (st = sim->method->restore(sim, err)) != SPH_OK)
+    goto done;
   sim->t = h.t;
   sim->steps = (unsigned long)h.steps;
   sim->dt_min = h.dt_min;

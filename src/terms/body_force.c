@@ -1,4 +1,5 @@
-/* Body force per unit reference volume, E_a = rho0 g (seed 000 eq. 27c). */
+/* Body force per unit reference volume, E_a = rho0 g (seed 000 eq. 27c);
+ * with rho0 NULL the state is the velocity and the rate is g itself. */
 #include <stdlib.h>
 
 #include "terms/terms_impl.h"
@@ -15,7 +16,7 @@ static sph_status body_force_rates(sph_term *term, sph_sim *sim,
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
-      stage->dp[3 * a + c] += f->rho0[a] * f->g[c];
+      stage->dp[3 * a + c] += (f->rho0 ? f->rho0[a] : 1.0) * f->g[c];
   return SPH_OK;
 }
 

@@ -48,8 +48,9 @@ static void apply(essential_bc *e, double t, double *p, double *dp) {
         if (dp)
           dp[3 * a + c] = 0.0;
         if (p)
-          p[3 * a + c] =
-              bc->kind == SPH_BC_VELOCITY ? e->rho0[a] * bc->value[c] : 0.0;
+          p[3 * a + c] = bc->kind == SPH_BC_VELOCITY
+                             ? (e->rho0 ? e->rho0[a] : 1.0) * bc->value[c]
+                             : 0.0;
       }
     }
   }

@@ -37,12 +37,14 @@ typedef struct jst_params {
 sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
                                   sph_error *err);
 
-/* Body force E_a = rho0 g (seed 000 eq. 27c) added to dp. */
+/* Body force E_a = rho0 g (seed 000 eq. 27c) added to dp (g itself when
+ * rho0 is NULL: updated methods integrate the velocity). */
 sph_status body_force_create(sph_sim *sim, const double *rho0, sph_error *err);
 
 /* Essential boundary conditions imposed directly on particles (seed 000
  * Algorithm 1 step 8): clamp, roller, prescribed velocity over a window.
- * Acts on momentum per reference volume (p = rho0 v). */
+ * Acts on momentum per reference volume (p = rho0 v), or on the velocity
+ * when rho0 is NULL. */
 sph_status essential_bc_create(sph_sim *sim, const double *rho0,
                                sph_error *err);
 

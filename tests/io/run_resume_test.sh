@@ -2,7 +2,7 @@
 # Checkpoints and resume (issue: streaming outputs): a run killed with
 # SIGKILL mid-way leaves files VTK reads cleanly; --resume continues from the
 # newest checkpoint and produces the same frames, CSV rows and summary
-# numbers as an uninterrupted run (serial, bit-identical) for both methods;
+# numbers as an uninterrupted run (serial, bit-identical) for every method;
 # damaged, missing and mismatched checkpoints are refused; a write failure
 # (file size limit standing in for a full disk) stops the run with an error
 # naming the file and leaves no temporary file behind.
@@ -16,16 +16,18 @@ check=(/usr/bin/python3 "$(dirname "$0")/check_vtk.py")
 fails=0
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
-same_run() { # uninterrupted dir, resumed dir
-  local a=$1 b=$2 n=0
+same_run() { # uninterrupted dir, resumed dir, scene name
+  local a=$1 b=$2 name=$3 n=0
   for f in "$a"/*.vtp; do
     n=$((n + 1))
     cmp -s "$f" "$b/$(basename "$f")" || fail "$(basename "$f") differs after resume"
   done
   [ "$(ls "$b"/*.vtp | wc -l)" -eq "$n" ] || fail "resumed run wrote a different number of frames"
-  for f in energy.csv probes.csv twisting_column.pvd; do
+  for f in energy.csv "$name.pvd"; do
     cmp -s "$a/$f" "$b/$f" || fail "$f differs after resume"
   done
+  [ ! -f "$a/probes.csv" ] || cmp -s "$a/probes.csv" "$b/probes.csv" ||
+    fail "probes.csv differs after resume"
   # summary numbers (not wall times)
   for key in steps dt_min dt_max energy J linear_momentum_drift angular_momentum_drift stable; do
     [ "$(grep "\"$key\"" "$a/summary.json")" = "$(grep "\"$key\"" "$b/summary.json")" ] ||
@@ -34,10 +36,11 @@ same_run() { # uninterrupted dir, resumed dir
   echo "  compared $n frames"
 }
 
-kill_and_resume() { # label, extra --set options...
-  local label=$1
-  shift
-  local args=(--threads 1 --quiet --set time.end=0.3 --set output.checkpoint_every=0.02 "$@")
+kill_and_resume() { # label, scene name, end, checkpoint interval, --set options...
+  local label=$1 name=$2 end=$3 every=$4
+  shift 4
+  local scene=$src/scenes/$name.yaml
+  local args=(--threads 1 --quiet --set time.end=$end --set output.checkpoint_every=$every "$@")
   "$sph" run "$scene" --out "$work/$label-a" "${args[@]}" >/dev/null || fail "$label: uninterrupted run"
   "$sph" run "$scene" --out "$work/$label-b" "${args[@]}" >/dev/null &
   local pid=$! waited=0
@@ -49,16 +52,20 @@ kill_and_resume() { # label, extra --set options...
   wait $pid 2>/dev/null
   [ $waited -eq 1 ] || fail "$label: the run ended before it could be killed"
   [ -f "$work/$label-b/summary.json" ] && fail "$label: killed run has a summary"
-  "${check[@]}" --series "$work/$label-b" twisting_column >/dev/null ||
+  "${check[@]}" --series "$work/$label-b" "$name" >/dev/null ||
     fail "$label: files of the killed run do not read cleanly"
   "$sph" run "$scene" --resume "$work/$label-b" "${args[@]}" >/dev/null ||
     fail "$label: resume failed"
   echo "$label:"
-  same_run "$work/$label-a" "$work/$label-b"
+  same_run "$work/$label-a" "$work/$label-b" "$name"
 }
 
-kill_and_resume tl-jst
-kill_and_resume tl-csph --set 'method={name: tl-csph}'
+kill_and_resume tl-jst twisting_column 0.3 0.02
+kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}'
+# ul-sph: the configuration (neighbours, pair geometry) is rebuilt from the
+# checkpoint's positions of the last update
+kill_and_resume ul-sph colliding_rings 0.006 0.0005 \
+  --set bodies.0.particles.spacing=0.002 --set bodies.1.particles.spacing=0.002
 
 # damaged and mismatched checkpoints are refused, nothing is changed
 d=$work/tl-jst-b

@@ -231,6 +231,30 @@ START_TEST(products_and_small_helpers) {
 }
 END_TEST
 
+/* Jacobi eigen-decomposition: Q diag(w) Q^T = A, Q orthonormal, also for
+ * repeated and already diagonal cases */
+START_TEST(symmetric_eigen) {
+  const double cases[3][9] = {{2, 1, 0.5, 1, 3, -0.2, 0.5, -0.2, -1},
+                              {5, 2, 0, 2, -1, 0, 0, 0, -3},
+                              {4, 0, 0, 0, 4, 0, 0, 0, 1}};
+  for (int k = 0; k < 3; ++k) {
+    const double *A = cases[k];
+    double w[3], Q[9];
+    sph_mat3_sym_eigen(A, w, Q);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        double a = 0.0, q = 0.0;
+        for (int i = 0; i < 3; ++i) {
+          a += Q[3 * r + i] * w[i] * Q[3 * c + i];
+          q += Q[3 * i + r] * Q[3 * i + c];
+        }
+        ck_assert_double_eq_tol(a, A[3 * r + c], 1e-13);
+        ck_assert_double_eq_tol(q, r == c, 1e-14);
+      }
+  }
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("tensor");
   TCase *tc = tcase_create("tensor");
@@ -239,6 +263,7 @@ int main(void) {
   tcase_add_test(tc, inverse_cofactor_and_cross);
   tcase_add_test(tc, cross_with_identity);
   tcase_add_test(tc, products_and_small_helpers);
+  tcase_add_test(tc, symmetric_eigen);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }

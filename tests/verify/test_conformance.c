@@ -1,7 +1,8 @@
 /* The shared conformance suite, run against every method of the registry
  * (as SUNDIALS runs one suite against every vector implementation):
  * a body at rest stays at rest, a rigid translation stays rigid and
- * stress-free, momentum of a free body is conserved, and runs repeat
+ * stress-free, momentum of a free body is conserved (angular momentum
+ * for the methods that claim it), and runs repeat
  * bitwise (serial) and to 1e-12 across thread counts. */
 #include "test_util.h"
 
@@ -27,7 +28,8 @@ static sph_sim *make_sim(const char *method, const char *velocity,
            "bodies:\n  - name: cube\n    material: rubber\n"
            "    shape: {box: {min: [-0.5, -0.5, -0.5], max: [0.5, 0.5, 0.5]}}\n"
            "    particles: {count: [5, 5, 5]}\n%s"
-           "time: {end: 1}\n",
+           "time: {end: 1}\n"
+           "output: {fields: [velocity, displacement, stress]}\n",
            method, velocity);
   int fd = mkstemp(path);
   ck_assert_int_ge(fd, 0);
@@ -142,8 +144,14 @@ START_TEST(free_body_conserves_momentum) {
     }
     ck_assert_msg(dl < 1e-12 * scale, "%s: linear momentum drift %g of %g",
                   (*m)->name, dl, scale);
-    ck_assert_msg(da < 1e-12 * scale, "%s: angular momentum drift %g of %g",
-                  (*m)->name, da, scale);
+    /* only methods that claim it (seed 002 sec. 6.10: ENOG does not) */
+    if ((*m)->conserves_angular_momentum)
+      ck_assert_msg(da < 1e-12 * scale, "%s: angular momentum drift %g of %g",
+                    (*m)->name, da, scale);
+    else
+      printf("%s: angular momentum drift %.3g of %.3g in 50 steps (not "
+             "conserved by this method)\n",
+             (*m)->name, da, scale);
     sph_sim_destroy(sim);
     sph_scene_destroy(s);
   }

@@ -178,6 +178,7 @@ const sph_method_ops tl_csph_method_ops = {
     .name = "tl-csph",
     .title = "Total-Lagrangian corrected SPH, displacement-based (baseline)",
     .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 2, eq. 8-11",
+    .conserves_angular_momentum = 1,
     .setup = tl_csph_setup,
     .stable_dt = tl_csph_stable_dt,
     .step = tl_csph_step,

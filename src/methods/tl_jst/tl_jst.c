@@ -435,6 +435,7 @@ const sph_method_ops tl_jst_method_ops = {
     .title = "Total-Lagrangian JST-SPH, mixed {p,F}/{p,F,J}/{p,F,H,J}",
     .reference = "seed 000 (Lee et al. 2016) sec. 3-7, Algorithm 1; seed 003 "
                  "eq. 11",
+    .conserves_angular_momentum = 1,
     .setup = tl_jst_setup,
     .stable_dt = tl_jst_stable_dt,
     .step = tl_jst_step,

@@ -1,0 +1,116 @@
+/* Pair interactions of ul-sph (seed 002): the low-dissipation Riemann
+ * solver (eq. 13-16, limiter in the dimensionless form of BENCHMARKS E.1),
+ * the Riemann continuity and pressure terms (eq. 11-12), the nested shear
+ * force (eq. 17), Gray et al.'s artificial stress force, the rotation-
+ * invariant Laplacian of the velocity (eq. 23) and the velocity gradient
+ * (eq. 18, or eq. 30 with the correction matrix B of eq. 31).
+ *
+ * Geometry of a pair (i, j) as cached at the last configuration update:
+ * e = (x_i - x_j) / r (the paper's e_ij), r, dW = W'(r) <= 0, so that
+ * grad_i W_ij = dW e. The Riemann problem is posed along -e (from i to j):
+ * U_L = -v_i.e, U_R = -v_j.e. */
+#ifndef SPH_UL_SPH_IACT_H
+#define SPH_UL_SPH_IACT_H
+
+#include <math.h>
+
+#include "sph/tensor.h"
+
+/* Interface velocity jump and pressure of one pair. */
+typedef struct ul_riemann {
+  double du;    /* U_L - U*: half the dissipative velocity jump */
+  double pstar; /* P* */
+} ul_riemann;
+
+/* eq. 13-16; `pressure_term` keeps (P_L - P_R) / (z_L + z_R) in U* */
+static inline ul_riemann
+ul_sph_iact_riemann(const double e[3], const double vi[3], const double vj[3],
+                    double rho_i, double rho_j, double p_i, double p_j,
+                    double c_i, double c_j, int pressure_term) {
+  double uL = -sph_vec3_dot(vi, e), uR = -sph_vec3_dot(vj, e);
+  double zL = rho_i * c_i, zR = rho_j * c_j, inv = 1.0 / (zL + zR);
+  double jump = uL - uR;
+  double beta = 3.0 * jump * 2.0 / (c_i + c_j);
+  beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
+  ul_riemann s;
+  s.du = (zR * jump - (pressure_term ? p_i - p_j : 0.0)) * inv;
+  s.pstar = (zL * p_j + zR * p_i + beta * zL * zR * jump) * inv;
+  return s;
+}
+
+/* eq. 11: d rho_i / dt += -2 rho_i V_j (U_L - U*) dW (times rho_i later) */
+static inline double ul_sph_iact_continuity(double Vj, double du, double dW) {
+  return -2.0 * Vj * du * dW;
+}
+
+/* eq. 12: dv_i / dt += -2 V_j P* / rho_i grad_i W (1 / rho_i later) */
+static inline void ul_sph_iact_pressure(double a[3], double Vj, double pstar,
+                                        double dW, const double e[3]) {
+  double s = -2.0 * Vj * pstar * dW;
+  for (int c = 0; c < 3; ++c)
+    a[c] += s * e[c];
+}
+
+/* eq. 17: dv_i / dt += V_j (sigma_i + sigma_j) grad_i W (1 / rho_i later) */
+static inline void ul_sph_iact_shear_stress(double a[3], double Vj,
+                                            const double si[9],
+                                            const double sj[9], double dW,
+                                            const double e[3]) {
+  for (int r = 0; r < 3; ++r) {
+    double s = 0.0;
+    for (int c = 0; c < 3; ++c)
+      s += (si[3 * r + c] + sj[3 * r + c]) * e[c];
+    a[r] += Vj * dW * s;
+  }
+}
+
+/* Gray et al. (2001): dv_i / dt += m_j f^n (R_i + R_j) grad_i W */
+static inline void ul_sph_iact_artificial_stress(double a[3], double mj,
+                                                 double fn, const double Ri[9],
+                                                 const double Rj[9], double dW,
+                                                 const double e[3]) {
+  for (int r = 0; r < 3; ++r) {
+    double s = 0.0;
+    for (int c = 0; c < 3; ++c)
+      s += (Ri[3 * r + c] + Rj[3 * r + c]) * e[c];
+    a[r] += mj * fn * dW * s;
+  }
+}
+
+/* eq. 23 without the 2 zeta: V_j (e . v_ij) / r dW e */
+static inline void ul_sph_iact_laplacian(double lap[3], double Vj,
+                                         const double vi[3], const double vj[3],
+                                         double r, double dW,
+                                         const double e[3]) {
+  double vij[3] = {vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2]};
+  double s = Vj * sph_vec3_dot(e, vij) / r * dW;
+  for (int c = 0; c < 3; ++c)
+    lap[c] += s * e[c];
+}
+
+/* eq. 31 before the inverse: M += V_j dW r e (x) e (= V_j r_ij (x) grad W) */
+static inline void ul_sph_iact_moment(double M[9], double Vj, double r,
+                                      double dW, const double e[3]) {
+  double s = Vj * r * dW;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      M[3 * a + b] += s * e[a] * e[b];
+}
+
+/* eq. 18 / eq. 30: L_i += V_j (v_i - v_j) (x) (B_i grad_i W); with B = M^-1
+ * this is exact for a linear field (B = -I for eq. 18's sign) */
+static inline void ul_sph_iact_velocity_gradient(double L[9], double Vj,
+                                                 const double vi[3],
+                                                 const double vj[3],
+                                                 const double B[9], double dW,
+                                                 const double e[3]) {
+  double g[3] = {dW * e[0], dW * e[1], dW * e[2]}, Bg[3];
+  sph_mat3_vec(B, g, Bg);
+  for (int a = 0; a < 3; ++a) {
+    double d = Vj * (vi[a] - vj[a]);
+    for (int b = 0; b < 3; ++b)
+      L[3 * a + b] += d * Bg[b];
+  }
+}
+
+#endif

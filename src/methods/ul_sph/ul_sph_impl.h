@@ -1,0 +1,44 @@
+/* Private state of the ul-sph method (seed 002). */
+#ifndef SPH_UL_SPH_IMPL_H
+#define SPH_UL_SPH_IMPL_H
+
+#include <stddef.h>
+
+#include "sph/neighbors.h"
+#include "sph/sim.h"
+
+typedef enum ul_shear {
+  UL_SHEAR_ORIGINAL,          /* SPH-OG: eq. 6-8, 17-18 */
+  UL_SHEAR_ARTIFICIAL_STRESS, /* SPH-OAS: OG + Gray et al. (2001) */
+  UL_SHEAR_LAPLACIAN          /* SPH-ENOG: eq. 23-24 */
+} ul_shear;
+
+typedef struct ul_sph {
+  struct sph_sim *sim;
+  ul_shear shear;
+  int dual;          /* dual-criteria stepping (eq. 25-29), else single */
+  int pressure_term; /* (P_L - P_R) in U* of the continuity equation */
+  double cfl_ad, cfl_ac, zeta;
+  double as_eps, as_n, as_w0; /* artificial stress: epsilon, n, W(dp) */
+  size_t n;
+  /* per particle */
+  double *x, *v, *rho, *drho, *p, *m; /* x, v: particle fields */
+  const double *rho0, *c0, *G;
+  double *acc;       /* acceleration of the acoustic step (3) */
+  double *acc_shear; /* eq. 24, accumulated (3), laplacian only */
+  double *sigma;     /* shear stress (9): OG, OAS, or for output */
+  double *R;         /* artificial stress (9), OAS only */
+  double *B;         /* correction matrix eq. 31 (9), stress output only */
+  double *work;      /* work done against the shear force per particle */
+  double *vol;       /* m / rho of the half step */
+  int stress;        /* integrate sigma (OG, OAS, or stress output) */
+  /* configuration: neighbours and pair geometry of the last update */
+  sph_neighbors *nl;
+  double *e, *r, *dW; /* per slot: 3, 1, 1 */
+  size_t slot_cap;
+  double config[2]; /* time of the next configuration update, updates */
+  double *xcfg;     /* positions at the last update (3) */
+  int timer_config, timer_pressure, timer_shear;
+} ul_sph;
+
+#endif
