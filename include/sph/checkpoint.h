@@ -2,7 +2,8 @@
  * determines every later step of a run, so `sph run --resume DIR` continues
  * exactly where a killed run left off.
  *
- * Layout (little-endian, version 1):
+ * Layout (little-endian, version 2; version 1 had no fracture and zig-zag
+ * scalars in the verdict):
  *   "SPHCKPT\0"  u32 version  u32 endianness tag 0x01020304
  *   u64 particles  char method[32]  char scene[64]  u32 scene_crc
  *   f64 t  u64 steps  f64 dt_min dt_max dt_last  i32 next_output
@@ -19,7 +20,7 @@
 #include "sph/stability.h"
 #include "sph/status.h"
 
-#define SPH_CHECKPOINT_VERSION 1u
+#define SPH_CHECKPOINT_VERSION 2u
 #define SPH_CHECKPOINT_FILE "checkpoint.sphc"
 #define SPH_CHECKPOINT_PREVIOUS "checkpoint.prev.sphc"
 

@@ -159,6 +159,14 @@ typedef struct sph_output {
   double checkpoint_every; /* 0 = off */
 } sph_output;
 
+/* Thresholds of the stability verdict the scene may change (the optional
+ * top-level `stability:` block; defaults in stability.h, 0 turns an
+ * indicator off). */
+typedef struct sph_stability_options {
+  double fracture_dp; /* initially adjacent pairs farther apart, in dp */
+  double zigzag_max;  /* von Mises roughness */
+} sph_stability_options;
+
 typedef struct sph_scene {
   char name[SPH_NAME_MAX];
   char path[512];
@@ -180,6 +188,7 @@ typedef struct sph_scene {
   double body_force[3]; /* acceleration, m/s^2 */
   double t_end;
   sph_output output;
+  sph_stability_options stability;
 } sph_scene;
 
 /* Loads and validates `path`, after applying `nset` overrides "a.b=value". */

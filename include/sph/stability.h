@@ -10,14 +10,51 @@
  *    s_a = (-1)^(i+j+k) the parity of the particle's lattice index (bodies
  *    made from a lattice, jittered or not; relaxed bodies carry no parity).
  *    0 <= C <= 1: about 0 for smooth fields, 1 for a pure red-black
- *    alternation; tripped above SPH_CHECKERBOARD_MAX. */
+ *    alternation; tripped above SPH_CHECKERBOARD_MAX;
+ *  - numerical fracture (seed 002 sec. 6.1, 6.3; BENCHMARKS.md E.5): the
+ *    pairs of particles of one body that are initially adjacent (reference
+ *    distance <= SPH_FRACTURE_ADJACENT dp, dp the body's spacing) are listed
+ *    once; at every frame the largest current distance of a listed pair, in
+ *    units of dp, is the stretch, and the run trips when a pair is more than
+ *    SPH_FRACTURE_DP dp apart (OG passes 2 dp at t = 0.0011 on the rings,
+ *    ENOG stays within 1.26 dp). A uniform stretch lambda moves the
+ *    diagonal neighbours (sqrt(2) dp) to sqrt(2) lambda dp, so scenes with
+ *    physical stretches beyond about 1.4 raise `stability: {fracture_dp}`;
+ *  - zig-zag (hourglass) pattern of the von Mises stress s (seed 002 Fig. 1c,
+ *    9): R = sqrt(sum V (s - s~)^2) / sqrt(sum V (s - sbar)^2), s~_a the
+ *    Shepard average of s over a's neighbours of the same body in the
+ *    current configuration (Wendland C2, h = 1.3 dp, a itself excluded) and
+ *    sbar the volume-weighted mean; NaN when the field is uniform (spread
+ *    below SPH_ZIGZAG_FLOOR times the largest shear modulus). Measured in
+ *    tests/unit/test_verdict.c on lattices jittered by 0.25 dp (2D 20 x 20,
+ *    3D 10 x 10 x 10): smooth linear / quadratic fields 0.030 / 0.044 (2D),
+ *    0.060 / 0.086 (3D); the same plus an alternation +-0.2 (max - min)
+ *    0.942 / 0.870 (2D), 0.864 / 0.814 (3D); +-0.1: 0.58 / 0.51, 0.55 /
+ *    0.50; a pure alternation 1.42 (2D), 1.23 (3D). Tripped above
+ *    SPH_ZIGZAG_MAX = 0.5: 5.8 times the roughest smooth field, 1.6 times
+ *    below the mildest 20 % alternation, i.e. alternations of more than
+ *    about 10 % of the field's range. Fields resolved by few particles are
+ *    rough too: the shipped tl-jst scenes measure 0.12 (swinging cube) to
+ *    0.56 (twisting column, 5 across), 0.90 (spinning cube, 6 across) and
+ *    1.03 (inertial punch, stress concentration), with no red-black
+ *    pattern; such scenes raise or switch off `stability: {zigzag_max}`.
+ * Both work from positions, reference positions, body ids and von Mises
+ * only, so they apply to every method; their lists are allocated at
+ * creation (the current-configuration lists grow only when an output
+ * frame needs more room) and cost O(N) per frame. */
 #ifndef SPH_STABILITY_H
 #define SPH_STABILITY_H
 
+#include "sph/neighbors.h"
 #include "sph/sink.h"
 
 #define SPH_ENERGY_GROWTH_MAX 0.05
 #define SPH_CHECKERBOARD_MAX 0.5
+#define SPH_FRACTURE_ADJACENT 1.5
+#define SPH_FRACTURE_DP 2.0
+#define SPH_ZIGZAG_H_OVER_DP 1.3
+#define SPH_ZIGZAG_FLOOR 1e-8
+#define SPH_ZIGZAG_MAX 0.5
 
 typedef struct sph_verdict {
   int stable;
@@ -33,14 +70,36 @@ typedef struct sph_verdict {
   double lin_drift, ang_drift; /* largest relative drift seen */
   signed char *parity;         /* s_a = +-1, 0 without a lattice */
   int has_parity;
+  /* numerical fracture: threshold in dp (0 = not judged), adjacent pairs */
+  double fracture_dp;
+  size_t npairs;
+  int32_t *pairs;               /* 2 * npairs particle indices */
+  double fracture_max_stretch;  /* this frame: max |x_a - x_b| / dp */
+  long fracture_pairs_over;     /* this frame: pairs beyond fracture_dp */
+  double fracture_peak_stretch; /* largest over the frames */
+  long fracture_peak_over;
+  /* zig-zag: threshold (0 = not judged), R of the latest frame (NaN when
+   * not measured) and the largest */
+  double zigzag_threshold;
+  double zigzag, zigzag_max;
+  double stress_floor; /* SPH_ZIGZAG_FLOOR * the largest shear modulus */
+  size_t n;            /* particles the lists were made for */
+  size_t nbodies;
+  double *body_dp;         /* spacing of every body */
+  sph_kernel *body_kernel; /* Wendland C2 with h = 1.3 dp of every body */
+  double zigzag_radius;    /* largest support */
+  sph_neighbors *nl;       /* current-configuration lists, reused */
+  double *work;            /* n entries */
 } sph_verdict;
 
 sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
                               sph_error *err);
 void sph_verdict_destroy(sph_verdict *v);
 
-/* Updates the indicators from a frame (after method->derive). */
-void sph_verdict_observe(sph_verdict *v, const sph_frame *frame);
+/* Updates the indicators from a frame (after method->derive); fails only
+ * when the neighbour lists cannot grow. */
+sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *frame,
+                               sph_error *err);
 
 /* Marks the run unstable for a reason found elsewhere (a failed step). */
 void sph_verdict_fail(sph_verdict *v, double t, const char *reason);

@@ -115,7 +115,8 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
   sim->method->energy(sim, &fr.kinetic, &fr.strain);
   for (int i = 0; i < nsinks && st == SPH_OK; ++i)
     st = sinks[i].ops->write(&sinks[i], &fr, err);
-  sph_verdict_observe(v, &fr);
+  if (st == SPH_OK)
+    st = sph_verdict_observe(v, &fr, err);
   return st;
 }
 

@@ -2,6 +2,7 @@
 #include "sph/stability.h"
 
 #include "sph/geometry.h"
+#include "sph/neighbors.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -52,6 +53,75 @@ void sph_lattice_parity(const sph_scene *s, const sph_particles *ps,
   }
 }
 
+static double pair_distance(const double *x, size_t a, size_t b, int dim) {
+  double d2 = 0.0;
+  for (int c = 0; c < dim; ++c) {
+    double d = x[3 * a + c] - x[3 * b + c];
+    d2 += d * d;
+  }
+  return sqrt(d2);
+}
+
+/* Per-body spacings and kernels, the current-configuration neighbour lists
+ * (sized by a build in the reference configuration) and the initially
+ * adjacent pairs, taken from that same build. */
+static sph_status lists_create(sph_verdict *v, const sph_scene *s,
+                               const sph_particles *ps, sph_error *err) {
+  v->fracture_dp = s->stability.fracture_dp;
+  v->zigzag_threshold = s->stability.zigzag_max;
+  v->zigzag = v->zigzag_max = NAN;
+  for (size_t m = 0; m < s->nmaterials; ++m)
+    v->stress_floor = fmax(v->stress_floor, s->materials[m].mu);
+  v->stress_floor *= SPH_ZIGZAG_FLOOR;
+  v->nbodies = s->nbodies;
+  v->n = ps->n;
+  size_t nb = s->nbodies ? s->nbodies : 1, n = ps->n;
+  v->body_dp = calloc(nb, sizeof *v->body_dp);
+  v->body_kernel = calloc(nb, sizeof *v->body_kernel);
+  v->work = malloc((n ? n : 1) * sizeof *v->work);
+  if (!v->body_dp || !v->body_kernel || !v->work)
+    return sph_error_set(err, SPH_ERR_NOMEM, "verdict");
+  int dim = s->dimension;
+  for (size_t b = 0; b < s->nbodies; ++b) {
+    v->body_dp[b] = s->bodies[b].spacing;
+    SPH_TRY(sph_kernel_create(&v->body_kernel[b], SPH_KERNEL_WENDLAND_C2, dim,
+                              SPH_ZIGZAG_H_OVER_DP * v->body_dp[b], err));
+    v->zigzag_radius = fmax(v->zigzag_radius, v->body_kernel[b].support);
+  }
+  SPH_TRY(sph_neighbors_create(&v->nl, err));
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  if (!n || !X || !(v->zigzag_radius > 0.0))
+    return SPH_OK;
+  /* the kernel support (2.6 dp) covers 1.5 dp: one build serves both */
+  SPH_TRY(sph_neighbors_build(v->nl, X, n, dim, v->zigzag_radius, ps->body,
+                              SPH_PAIRS_SAME_BODY, err));
+  const sph_neighbors *nl = v->nl;
+  for (int pass = 0; pass < 2; ++pass) {
+    size_t k = 0;
+    for (size_t a = 0; a < n; ++a) {
+      double lim = SPH_FRACTURE_ADJACENT * v->body_dp[ps->body[a]] *
+                   (1.0 + 1e-9); /* round-off of lattice distances */
+      for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
+        size_t b = (size_t)nl->index[j];
+        if (b <= a || pair_distance(X, a, b, dim) > lim)
+          continue;
+        if (pass == 1) {
+          v->pairs[2 * k] = (int32_t)a;
+          v->pairs[2 * k + 1] = (int32_t)b;
+        }
+        ++k;
+      }
+    }
+    if (pass == 0) {
+      v->npairs = k;
+      v->pairs = malloc((k ? 2 * k : 1) * sizeof *v->pairs);
+      if (!v->pairs)
+        return sph_error_set(err, SPH_ERR_NOMEM, "verdict: %zu pairs", k);
+    }
+  }
+  return SPH_OK;
+}
+
 sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
                               sph_error *err) {
   sph_verdict *v = calloc(1, sizeof *v);
@@ -74,6 +144,11 @@ sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
   sph_lattice_parity(s, ps, v->parity);
   for (size_t a = 0; a < ps->n; ++a)
     v->has_parity |= v->parity[a] != 0;
+  sph_status st = lists_create(v, s, ps, err);
+  if (st != SPH_OK) {
+    sph_verdict_destroy(v);
+    return st;
+  }
   *out = v;
   return SPH_OK;
 }
@@ -82,6 +157,11 @@ void sph_verdict_destroy(sph_verdict *v) {
   if (!v)
     return;
   free(v->parity);
+  free(v->pairs);
+  free(v->body_dp);
+  free(v->body_kernel);
+  free(v->work);
+  sph_neighbors_destroy(v->nl);
   free(v);
 }
 
@@ -102,7 +182,82 @@ static int all_finite(const double *f, size_t count) {
   return 1;
 }
 
-void sph_verdict_observe(sph_verdict *v, const sph_frame *fr) {
+/* Largest stretch of the initially adjacent pairs and the count beyond
+ * the threshold. */
+static void fracture_update(sph_verdict *v, const sph_particles *ps) {
+  const double *x = ps->field[SPH_FIELD_POSITION];
+  if (!x || !v->npairs || ps->n != v->n) /* lists of other particles */
+    return;
+  double worst = 0.0;
+  long over = 0;
+  for (size_t k = 0; k < v->npairs; ++k) {
+    size_t a = (size_t)v->pairs[2 * k], b = (size_t)v->pairs[2 * k + 1];
+    double r = pair_distance(x, a, b, ps->dim) / v->body_dp[ps->body[a]];
+    worst = r > worst ? r : worst;
+    over += v->fracture_dp > 0.0 && r > v->fracture_dp;
+  }
+  v->fracture_max_stretch = worst;
+  v->fracture_pairs_over = over;
+  v->fracture_peak_stretch = fmax(v->fracture_peak_stretch, worst);
+  v->fracture_peak_over =
+      over > v->fracture_peak_over ? over : v->fracture_peak_over;
+}
+
+/* Roughness R of the von Mises field (stability.h); NaN without the field
+ * or for a uniform one. */
+static sph_status zigzag_update(sph_verdict *v, const sph_particles *ps,
+                                sph_error *err) {
+  const double *x = ps->field[SPH_FIELD_POSITION];
+  const double *s = ps->field[SPH_FIELD_VON_MISES];
+  const double *V = ps->field[SPH_FIELD_VOLUME0];
+  v->zigzag = NAN;
+  if (!x || !s || !ps->n || ps->n != v->n || !(v->zigzag_radius > 0.0))
+    return SPH_OK;
+  SPH_TRY(sph_neighbors_build(v->nl, x, ps->n, ps->dim, v->zigzag_radius,
+                              ps->body, SPH_PAIRS_SAME_BODY, err));
+  const sph_neighbors *nl = v->nl;
+  double *smooth = v->work;
+  long n = (long)ps->n;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    const sph_kernel *k = &v->body_kernel[ps->body[a]];
+    double sw = 0.0, sws = 0.0;
+    for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
+      size_t b = (size_t)nl->index[j];
+      double w = sph_kernel_eval(k, pair_distance(x, (size_t)a, b, ps->dim));
+      sw += w;
+      sws += w * s[b];
+    }
+    /* isolated particles (no neighbour within the support) are left out */
+    smooth[a] = sw > 0.0 ? sws / sw : NAN;
+  }
+  double sv = 0.0, mean = 0.0;
+  for (long a = 0; a < n; ++a)
+    if (!isnan(smooth[a])) {
+      double Va = V ? V[a] : 1.0;
+      sv += Va;
+      mean += Va * s[a];
+    }
+  if (!(sv > 0.0))
+    return SPH_OK;
+  mean /= sv;
+  double rough = 0.0, spread = 0.0;
+  for (long a = 0; a < n; ++a)
+    if (!isnan(smooth[a])) {
+      double Va = V ? V[a] : 1.0;
+      rough += Va * (s[a] - smooth[a]) * (s[a] - smooth[a]);
+      spread += Va * (s[a] - mean) * (s[a] - mean);
+    }
+  /* a uniform field (to round-off of the stress scale) has no pattern */
+  if (!(spread > 0.0) || sqrt(spread / sv) <= v->stress_floor)
+    return SPH_OK;
+  v->zigzag = sqrt(rough / spread);
+  v->zigzag_max = fmax(v->zigzag_max, v->zigzag);
+  return SPH_OK;
+}
+
+sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
+                               sph_error *err) {
   const sph_particles *ps = fr->ps;
   size_t n = ps->n;
   char msg[256];
@@ -113,7 +268,7 @@ void sph_verdict_observe(sph_verdict *v, const sph_frame *fr) {
       !isfinite(fr->kinetic + fr->strain)) {
     v->nan = 1;
     sph_verdict_fail(v, fr->time, "nan: non-finite state");
-    return;
+    return SPH_OK;
   }
   /* Jacobian */
   const double *J = ps->field[SPH_FIELD_JACOBIAN];
@@ -182,5 +337,27 @@ void sph_verdict_observe(sph_verdict *v, const sph_frame *fr) {
       sph_verdict_fail(v, fr->time, msg);
     }
   }
+  /* numerical fracture */
+  fracture_update(v, ps);
+  if (v->fracture_pairs_over > 0) {
+    snprintf(msg, sizeof msg,
+             "numerical fracture: %ld initially adjacent pair%s more than %g "
+             "dp apart (largest %.3g dp)",
+             v->fracture_pairs_over, v->fracture_pairs_over == 1 ? "" : "s",
+             v->fracture_dp, v->fracture_max_stretch);
+    sph_verdict_fail(v, fr->time, msg);
+  }
+  /* zig-zag pattern of the von Mises stress */
+  sph_status st = zigzag_update(v, ps, err);
+  if (st != SPH_OK)
+    return st;
+  if (v->zigzag_threshold > 0.0 &&
+      isgreater(v->zigzag, v->zigzag_threshold)) { /* quiet for NaN */
+    snprintf(msg, sizeof msg,
+             "zig-zag pattern: von Mises roughness %.3g above %.3g", v->zigzag,
+             v->zigzag_threshold);
+    sph_verdict_fail(v, fr->time, msg);
+  }
   v->frames++;
+  return SPH_OK;
 }

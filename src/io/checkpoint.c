@@ -41,6 +41,12 @@ static const struct {
     VERDICT_FIELD(ang_scale),
     VERDICT_FIELD(lin_drift),
     VERDICT_FIELD(ang_drift),
+    VERDICT_FIELD(fracture_max_stretch),
+    VERDICT_FIELD(fracture_pairs_over),
+    VERDICT_FIELD(fracture_peak_stretch),
+    VERDICT_FIELD(fracture_peak_over),
+    VERDICT_FIELD(zigzag),
+    VERDICT_FIELD(zigzag_max),
 };
 #define NVERDICT (sizeof verdict_fields / sizeof *verdict_fields)
 

@@ -84,6 +84,11 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_number(f, v->J_max);
   fputs("},\n  \"checkerboard_max\": ", f);
   json_number(f, v->checkerboard_max);
+  fputs(",\n  \"fracture\": {\"max_stretch_dp\": ", f);
+  json_number(f, v->npairs ? v->fracture_peak_stretch : NAN);
+  fprintf(f,
+          ", \"pairs_over\": %ld},\n  \"zigzag_max\": ", v->fracture_peak_over);
+  json_number(f, v->zigzag_max);
   fprintf(f, ",\n  \"nan\": %s,\n  \"stable\": %s,\n  \"reason\": ",
           v->nan ? "true" : "false", v->stable ? "true" : "false");
   json_string(f, v->reason);

@@ -13,6 +13,7 @@
 #include "sph/expr.h"
 #include "sph/geometry.h"
 #include "sph/neighbors.h"
+#include "sph/stability.h"
 
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 
@@ -859,14 +860,41 @@ static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
   return SPH_OK;
 }
 
+/* A threshold of the stability block: >= 0, 0 turns the indicator off. */
+static sph_status threshold(sph_node *map, const char *key, double def,
+                            double *out, sph_error *err) {
+  SPH_TRY(sph_node_get_double(map, key, 0, def, out, err));
+  if (!(*out >= 0.0) || !isfinite(*out))
+    return sph_node_error(sph_node_child(map, key), err, SPH_ERR_RANGE,
+                          "must be >= 0 (0 turns the indicator off), got %g",
+                          *out);
+  return SPH_OK;
+}
+
+static sph_status parse_stability(sph_scene *s, sph_node *root,
+                                  sph_error *err) {
+  sph_node *st;
+  SPH_TRY(sph_node_insert_default(root, "stability", "{}", &st, err));
+  if (st->kind != SPH_NODE_MAP)
+    return sph_node_error(st, err, SPH_ERR_TYPE, "expected a mapping");
+  static const char *const keys[] = {"fracture_dp", "zigzag_max", NULL};
+  SPH_TRY(sph_node_check_keys(st, keys, err));
+  SPH_TRY(threshold(st, "fracture_dp", SPH_FRACTURE_DP,
+                    &s->stability.fracture_dp, err));
+  SPH_TRY(threshold(st, "zigzag_max", SPH_ZIGZAG_MAX, &s->stability.zigzag_max,
+                    err));
+  return SPH_OK;
+}
+
 static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   if (root->kind != SPH_NODE_MAP)
     return sph_node_error(root, err, SPH_ERR_TYPE,
                           "a scene is a mapping of keys (name, dimension, "
                           "method, materials, bodies, time, ...)");
   static const char *const keys[] = {
-      "name",       "dimension",  "method", "kernel", "materials", "bodies",
-      "boundaries", "body_force", "time",   "output", "reference", NULL};
+      "name",      "dimension",  "method",     "kernel", "materials",
+      "bodies",    "boundaries", "body_force", "time",   "output",
+      "reference", "stability",  NULL};
   SPH_TRY(sph_node_check_keys(root, keys, err));
   const char *name;
   SPH_TRY(sph_node_get_string(root, "name", 1, NULL, &name, err));
@@ -906,6 +934,7 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
                                  err));
   }
   SPH_TRY(parse_output(s, root, err));
+  SPH_TRY(parse_stability(s, root, err));
   return SPH_OK;
 }
 

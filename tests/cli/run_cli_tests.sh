@@ -56,10 +56,14 @@ rc=$?
 [ $rc -ne 0 ] && grep -qF "$work/plainfile/out" "$work/stderr" && [ ! -e "$work/plainfile/out" ] && ok ||
   bad "unwritable output (exit $rc): $(cat "$work/stderr")"
 
-# a tiny run end to end, then the overwrite guard
+# a tiny run end to end, then the overwrite guard; 3 x 7 x 3 particles
+# (0.5 m across, 1 m along) resolve nothing at the particle scale, so the
+# zig-zag indicator is off (its von Mises roughness reaches 1.15)
 tiny="$work/tiny.yaml"
 sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
-  -e 's/every: 0.005/every: 0.005/' "$src/scenes/twisting_column.yaml" >"$tiny"
+  -e 's/every: 0.005/every: 0.005/' \
+  -e 's/^stability: .*/stability: {fracture_dp: 3, zigzag_max: 0}/' \
+  "$src/scenes/twisting_column.yaml" >"$tiny"
 "$sph" run "$tiny" --out "$work/run" --quiet >"$work/stdout" 2>&1
 rc=$?
 if [ $rc -eq 0 ] && [ -f "$work/run/summary.json" ] && [ -f "$work/run/energy.csv" ] &&

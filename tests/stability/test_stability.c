@@ -47,7 +47,8 @@ static outcome run(const char *name, const char *const *sets, size_t nsets,
     ck_assert(sim->method->derive(sim, &err) == SPH_OK);
     sph_frame fr = {.time = sim->t, .sim = sim, .ps = sim->ps};
     sim->method->energy(sim, &fr.kinetic, &fr.strain);
-    sph_verdict_observe(v, &fr);
+    ck_assert_msg(sph_verdict_observe(v, &fr, &err) == SPH_OK, "%s",
+                  err.message);
     if (frames++ > 0) /* the state at rest has no pressure to judge */
       sum += v->checkerboard;
     if (next >= s->t_end)
