@@ -5,6 +5,7 @@
  *  - energy growth: kinetic + strain energy above (1 + SPH_ENERGY_GROWTH_MAX)
  *    times its initial value (only for scenes without prescribed velocities
  *    or body forces, whose external work is not tracked);
+ *    the kinetic energy alone above the same bound of the initial total;
  *  - pressure checkerboard: the red-black mode fraction of BENCHMARKS.md
  *    D.3, C = |sum V s (p - pbar)| / sqrt(sum V * sum V (p - pbar)^2) with
  *    s_a = (-1)^(i+j+k) the parity of the particle's lattice index (bodies

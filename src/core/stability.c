@@ -296,6 +296,17 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
              E, v->energy0, 100 * SPH_ENERGY_GROWTH_MAX);
     sph_verdict_fail(v, fr->time, msg);
   }
+  /* without external work the kinetic energy is bounded by the initial
+   * total, whatever a method books as stored energy (ul-sph books the work
+   * of its shear force, which a non-conservative force can drive negative) */
+  if (v->energy_tracked && v->energy0 > 0.0 &&
+      fr->kinetic > (1.0 + SPH_ENERGY_GROWTH_MAX) * v->energy0) {
+    snprintf(msg, sizeof msg,
+             "energy growth: kinetic energy %.4g exceeds the initial total "
+             "%.4g by more than %.0f %%",
+             fr->kinetic, v->energy0, 100 * SPH_ENERGY_GROWTH_MAX);
+    sph_verdict_fail(v, fr->time, msg);
+  }
   /* momentum drift */
   double lin[3], ang[3];
   sph_momentum(ps, lin, ang);
