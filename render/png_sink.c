@@ -402,6 +402,9 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
                      .y = H / 5,
                      .width = W / 48 > 8 ? W / 48 : 8,
                      .height = 3 * H / 5};
+  int fit = W - (W / 64 > 4 ? W / 64 : 4) -
+            sph_colorbar_extent(&p->img, p->text, &cb);
+  cb.x = fit < cb.x ? fit : cb.x; /* labels inside small frames */
   sph_colorbar_draw(&p->img, p->text, &cb);
   snprintf(label, sizeof label, "%s\nt = %.5f s", p->name, fr->time);
   sph_overlay_label(&p->img, p->text, W / 64, H / 36, label);
