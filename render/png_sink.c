@@ -224,7 +224,7 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
   sph_status st = cut_mask(sim, &v, keep, err);
   const double *X = ps->field[SPH_FIELD_POSITION0];
   size_t kept = 0, seen = 0;
-  for (size_t a = 0; st == SPH_OK && a < ps->n; ++a) {
+  for (size_t a = 0; st == SPH_OK && a < ps->n && !seen; ++a) {
     if (!keep[a] || (o->clip && dot3(o->clip_normal, X + 3 * a) > o->clip_at))
       continue;
     ++kept;
