@@ -176,10 +176,46 @@ static void triangle(sph_image *img, const double v[3][2],
     }
 }
 
+/* Ticks and labels of a bar, the tick length and the labels' offset from
+ * the bar's left edge. */
+typedef struct bar_layout {
+  int px, n, tick_len, label_dx;
+  double ticks[11];
+  char labels[11][SPH_TICK_LABEL_MAX];
+} bar_layout;
+
+static void layout(const sph_image *img, const sph_colorbar *cb,
+                   bar_layout *l) {
+  l->px = cb->font_px > 0 ? cb->font_px : sph_overlay_font_px(img);
+  int max_ticks = (int)(cb->height / (2.2 * l->px));
+  max_ticks = max_ticks < 2 ? 2 : (max_ticks > 11 ? 11 : max_ticks);
+  l->n = sph_colorbar_ticks(cb->min, cb->max, max_ticks, l->ticks);
+  sph_colorbar_labels(l->ticks, l->n, l->labels);
+  l->tick_len = l->px / 3 < 3 ? 3 : l->px / 3;
+  l->label_dx = cb->width + 1 + l->tick_len + (l->px / 4 < 2 ? 2 : l->px / 4);
+}
+
+int sph_colorbar_extent(const sph_image *img, sph_text *t,
+                        const sph_colorbar *cb) {
+  if (!img || !cb || cb->width <= 0 || cb->height <= 0)
+    return 0;
+  bar_layout l;
+  layout(img, cb, &l);
+  int right = cb->width + 1;
+  for (int i = 0; i < l.n; ++i) {
+    int lw = sph_text_width(t, l.px, l.labels[i]);
+    right = l.label_dx + lw > right ? l.label_dx + lw : right;
+  }
+  return right;
+}
+
 void sph_colorbar_draw(sph_image *img, sph_text *t, const sph_colorbar *cb) {
   if (!img || !img->rgba || !cb || cb->width <= 0 || cb->height <= 0)
     return;
-  int px = cb->font_px > 0 ? cb->font_px : sph_overlay_font_px(img);
+  bar_layout l;
+  layout(img, cb, &l);
+  int px = l.px, n = l.n, tick_len = l.tick_len;
+  const double *ticks = l.ticks;
   const unsigned char *fg = cb->text_rgb;
   int x = cb->x, y = cb->y, w = cb->width, h = cb->height;
   unsigned char rgb[3], end_hi[3], end_lo[3];
@@ -210,14 +246,7 @@ void sph_colorbar_draw(sph_image *img, sph_text *t, const sph_colorbar *cb) {
   fill_rect(img, x - 1, y, x, y + h, fg);
   fill_rect(img, x + w, y, x + w + 1, y + h, fg);
   /* ticks at the value rows, labels centred on them by the digit height */
-  int max_ticks = (int)(h / (2.2 * px));
-  max_ticks = max_ticks < 2 ? 2 : (max_ticks > 11 ? 11 : max_ticks);
-  double ticks[11];
-  char labels[11][SPH_TICK_LABEL_MAX];
-  int n = sph_colorbar_ticks(cb->min, cb->max, max_ticks, ticks);
-  sph_colorbar_labels(ticks, n, labels);
-  int tick_len = px / 3 < 3 ? 3 : px / 3;
-  int lx = x + w + 1 + tick_len + (px / 4 < 2 ? 2 : px / 4);
+  int lx = x + l.label_dx;
   int digit[4];
   sph_text_bounds(t, px, "0", digit);
   int right = x + w + 1;
@@ -227,8 +256,8 @@ void sph_colorbar_draw(sph_image *img, sph_text *t, const sph_colorbar *cb) {
     int r = y + (int)floor(f * (h - 1) + 0.5);
     fill_rect(img, x + w + 1, r, x + w + 1 + tick_len, r + 1, fg);
     int base = r + (1 - digit[1] - digit[3]) / 2;
-    sph_text_draw(t, img, lx, base, px, labels[i], fg);
-    int lw = sph_text_width(t, px, labels[i]);
+    sph_text_draw(t, img, lx, base, px, l.labels[i], fg);
+    int lw = sph_text_width(t, px, l.labels[i]);
     right = lx + lw > right ? lx + lw : right;
   }
   /* title centred over bar and labels, above the triangle, inside the image */

@@ -1,7 +1,9 @@
 /* OSMesa sphere pass: a GL 3.3 core context with an off-screen framebuffer
  * draws each particle as an instanced camera-facing quad whose fragment
  * shader ray-casts the sphere (exact silhouette, normal and depth) and
- * shades it with a head-light; the frame is read back top row first. */
+ * shades it with a head-light (or not: flat silhouettes); layers of spheres
+ * are painted in order over one another; the frame is read back top row
+ * first. */
 #define GL_GLEXT_PROTOTYPES 1
 #include "gl_impl.h"
 
@@ -73,6 +75,7 @@ static const char *const fragment_src =
     "uniform mat4 proj;\n"
     "uniform float radius;\n"
     "uniform int ortho;\n"
+    "uniform int flat_colour;\n"
     "out vec4 frag;\n"
     "void main() {\n"
     "  vec3 light = normalize(vec3(-0.3, 0.4, 1.0));\n"
@@ -97,6 +100,10 @@ static const char *const fragment_src =
     "  float depth = 0.5 * clip.z / clip.w + 0.5;\n"
     "  if (depth < 0.0 || depth > 1.0) discard;\n"
     "  gl_FragDepth = depth;\n"
+    "  if (flat_colour != 0) {\n"
+    "    frag = vec4(v_colour, 1.0);\n"
+    "    return;\n"
+    "  }\n"
     "  float lambert = max(dot(n, light), 0.0);\n"
     "  vec3 half_vec = normalize(light + to_eye);\n"
     "  float spec = pow(max(dot(n, half_vec), 0.0), 48.0);\n"
@@ -111,6 +118,7 @@ struct sph_gl {
   GLuint program, vao, quad_vbo, centre_vbo, colour_vbo;
   GLuint fbo, colour_rb, depth_rb;
   GLint loc_view, loc_proj, loc_radius, loc_ortho, loc_use_clip, loc_plane;
+  GLint loc_flat;
   size_t capacity;         /* instances the centre/colour buffers hold */
   unsigned char *readback; /* width * height * 4, bottom row first */
 };
@@ -189,6 +197,7 @@ static sph_status build_program(sph_gl *gl, sph_error *err) {
   gl->loc_ortho = glGetUniformLocation(gl->program, "ortho");
   gl->loc_use_clip = glGetUniformLocation(gl->program, "use_clip");
   gl->loc_plane = glGetUniformLocation(gl->program, "clip_plane");
+  gl->loc_flat = glGetUniformLocation(gl->program, "flat_colour");
   return SPH_OK;
 }
 
@@ -375,9 +384,9 @@ static void set_state(sph_gl *gl) {
   glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
 }
 
-/* Uploads the camera, radius and clip plane uniforms. */
+/* Uploads the camera, radius, clip plane and shading uniforms. */
 static void set_uniforms(sph_gl *gl, const sph_view *view, float radius,
-                         const double *clip_plane) {
+                         const double *clip_plane, int flat) {
   double mv[16], pr[16];
   float mvf[16], prf[16];
   sph_view_matrix(view, mv);
@@ -392,6 +401,7 @@ static void set_uniforms(sph_gl *gl, const sph_view *view, float radius,
   glUniform1f(gl->loc_radius, radius);
   glUniform1i(gl->loc_ortho, view->ortho ? 1 : 0);
   glUniform1i(gl->loc_use_clip, clip_plane ? 1 : 0);
+  glUniform1i(gl->loc_flat, flat ? 1 : 0);
   if (clip_plane)
     glUniform4f(gl->loc_plane, (float)clip_plane[0], (float)clip_plane[1],
                 (float)clip_plane[2], (float)clip_plane[3]);
@@ -399,55 +409,68 @@ static void set_uniforms(sph_gl *gl, const sph_view *view, float radius,
     glUniform4f(gl->loc_plane, 0.f, 0.f, 0.f, 1.f);
 }
 
-sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
-                               const float *xyz, float radius,
-                               const unsigned char *rgb,
-                               const double *clip_plane, sph_image *img,
-                               sph_error *err) {
+/* Checks one layer's arguments. */
+static sph_status check_layer(const sph_gl_layer *l, sph_error *err) {
+  if (l->n > 0 && (!l->xyz || !l->rgb))
+    return sph_error_set(err, SPH_ERR_ARG, "render: missing centres/colours");
+  if (l->n > 0 && !(l->radius > 0.0f && isfinite(l->radius)))
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "render: sphere radius must be > 0, got %g",
+                         (double)l->radius);
+  if (l->clip_plane)
+    for (int k = 0; k < 4; ++k)
+      if (!isfinite(l->clip_plane[k]))
+        return sph_error_set(err, SPH_ERR_ARG, "render: non-finite clip plane");
+  for (size_t i = 0; i < 3 * l->n; ++i)
+    if (!isfinite(l->xyz[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "render: sphere %zu has a non-finite centre", i / 3);
+  if (l->n > (size_t)INT_MAX)
+    return sph_error_set(err, SPH_ERR_RANGE,
+                         "render: %zu spheres exceed one draw call", l->n);
+  return SPH_OK;
+}
+
+sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
+                              const sph_gl_layer *layers, int nlayers,
+                              sph_image *img, sph_error *err) {
   /* arguments */
-  if (!gl || !img)
+  if (!gl || !img || (nlayers > 0 && !layers))
     return sph_error_set(err, SPH_ERR_ARG, "render: missing context or image");
   if (img->width != gl->width || img->height != gl->height || !img->rgba)
     return sph_error_set(err, SPH_ERR_ARG,
                          "render: image is %d x %d, the context draws %d x %d",
                          img->width, img->height, gl->width, gl->height);
-  if (n > 0 && (!xyz || !rgb))
-    return sph_error_set(err, SPH_ERR_ARG, "render: missing centres/colours");
-  if (n > 0 && !(radius > 0.0f && isfinite(radius)))
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "render: sphere radius must be > 0, got %g",
-                         (double)radius);
-  if (clip_plane)
-    for (int k = 0; k < 4; ++k)
-      if (!isfinite(clip_plane[k]))
-        return sph_error_set(err, SPH_ERR_ARG, "render: non-finite clip plane");
+  size_t most = 0;
+  for (int i = 0; i < nlayers; ++i) {
+    SPH_TRY(check_layer(&layers[i], err));
+    most = layers[i].n > most ? layers[i].n : most;
+  }
   SPH_TRY(sph_view_check(view, err));
-  for (size_t i = 0; i < 3 * n; ++i)
-    if (!isfinite(xyz[i]))
-      return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "render: sphere %zu has a non-finite centre", i / 3);
-  if (n > (size_t)INT_MAX)
-    return sph_error_set(err, SPH_ERR_RANGE,
-                         "render: %zu spheres exceed one draw call", n);
   SPH_TRY(make_current(gl, err));
-  SPH_TRY(reserve(gl, n, err));
+  SPH_TRY(reserve(gl, most, err));
   /* state, background */
   set_state(gl);
   glClearColor(SPH_GL_BACKGROUND / 255.0f, SPH_GL_BACKGROUND / 255.0f,
                SPH_GL_BACKGROUND / 255.0f, 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  /* instances in index order */
-  if (n > 0) {
+  /* each layer's instances in index order, over the layers before it */
+  for (int i = 0; i < nlayers; ++i) {
+    const sph_gl_layer *l = &layers[i];
+    if (l->n == 0)
+      continue;
+    if (i > 0)
+      glClear(GL_DEPTH_BUFFER_BIT);
     glBindBuffer(GL_ARRAY_BUFFER, gl->centre_vbo);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(n * 3 * sizeof(float)),
-                    xyz);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(l->n * 3 * sizeof(float)),
+                    l->xyz);
     glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(n * 3), rgb);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(l->n * 3), l->rgb);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
-    set_uniforms(gl, view, radius, clip_plane);
+    set_uniforms(gl, view, l->radius, l->clip_plane, l->flat);
     glBindVertexArray(gl->vao);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)n);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)l->n);
     glBindVertexArray(0);
   }
   /* read back (GL rows run bottom-up) and flip into the image */
@@ -459,6 +482,15 @@ sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
     memcpy(img->rgba + (size_t)y * row,
            gl->readback + (size_t)(gl->height - 1 - y) * row, row);
   return SPH_OK;
+}
+
+sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
+                               const float *xyz, float radius,
+                               const unsigned char *rgb,
+                               const double *clip_plane, sph_image *img,
+                               sph_error *err) {
+  sph_gl_layer layer = {n, xyz, radius, rgb, clip_plane, 0};
+  return sph_gl_draw_layers(gl, view, &layer, 1, img, err);
 }
 
 void sph_gl_destroy(sph_gl *gl) {

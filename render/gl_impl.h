@@ -104,6 +104,26 @@ sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
                                const double *clip_plane, sph_image *img,
                                sph_error *err);
 
+/* One set of spheres of a frame, as the arguments of sph_gl_draw_spheres. */
+typedef struct sph_gl_layer {
+  size_t n;
+  const float *xyz;
+  float radius;
+  const unsigned char *rgb;
+  const double *clip_plane; /* NULL: no clip */
+  int flat;                 /* 1: the colour unshaded (a flat silhouette) */
+} sph_gl_layer;
+
+/* Draws nlayers layers into one frame, in order: each layer is depth-tested
+ * only against itself and painted over the ones before it, so an earlier
+ * layer shows only where the later ones leave background (a reference
+ * outline behind the current state). The same checks and errors as
+ * sph_gl_draw_spheres, which is this call with one layer; nlayers = 0 gives
+ * the background. */
+sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
+                              const sph_gl_layer *layers, int nlayers,
+                              sph_image *img, sph_error *err);
+
 /* Releases the context and its buffers. Accepts NULL. */
 void sph_gl_destroy(sph_gl *gl);
 

@@ -92,6 +92,11 @@ void sph_colorbar_labels(const double *ticks, int n,
  * (below) for clamped_high (clamped_low) and the title above it all, kept
  * inside the image. */
 void sph_colorbar_draw(sph_image *img, sph_text *t, const sph_colorbar *cb);
+/* Pixels sph_colorbar_draw uses right of cb->x for the bar, its ticks and
+ * the widest tick label (the title aside): cb->x = width - margin - extent
+ * keeps the labels inside the image. */
+int sph_colorbar_extent(const sph_image *img, sph_text *t,
+                        const sph_colorbar *cb);
 
 /* Default text height for an image: height / 32, within [12, 40]. */
 int sph_overlay_font_px(const sph_image *img);

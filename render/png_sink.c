@@ -11,8 +11,17 @@
  * run-wide `global` range needs a second pass over the frames and is not
  * done: it behaves as `auto`). NaN values get the map's own NaN colour. The
  * camera frames the bodies' initial bounding box, enlarged by 10 % on each
- * side for the motion, unless the scene gives a position. Created only when
- * the scene has a `png` block. */
+ * side for the motion, unless the scene gives a position (then the clip
+ * range and ortho height are fitted to that box seen from there).
+ *
+ * Cutaways: `clip` keeps the particles with n . x <= at (current position,
+ * the GL clip plane, whole spheres); `cut: half` keeps, per body, the
+ * particles whose reference position lies behind the body's reference
+ * centroid along the axis closest to the view direction, so the cut face
+ * looks at the camera.
+ * `ghost` paints the reference configuration as a grey outlined silhouette
+ * under the current state. sph_png_check validates all of this before a run.
+ * Created only when the scene has a `png` block. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -22,6 +31,7 @@
 
 #include "gl_impl.h"
 #include "overlay_impl.h"
+#include "sph/geometry.h"
 #include "sph/image.h"
 #include "sph/render.h"
 
@@ -34,6 +44,11 @@ typedef struct png_sink {
   float *xyz;
   unsigned char *rgb;
   double *value;
+  unsigned char *keep; /* cut: the particles drawn */
+  float *ghost_xyz;    /* reference positions of the kept particles */
+  unsigned char *ghost_rim, *ghost_fill; /* their colours */
+  size_t nkeep;
+  double plane[4]; /* clip: -n, at */
   sph_colormap_kind map;
   int have_range, symmetric, fixed;
   double lo, hi;
@@ -48,6 +63,202 @@ static double particle_value(const double *f, int nc, size_t a) {
     s += f[(size_t)nc * a + c] * f[(size_t)nc * a + c];
   return sqrt(s);
 }
+
+static double dot3(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The frame's camera: a fit of the initial bodies' box (padded for the
+ * motion), or the scene's position/target/up with the clip range and ortho
+ * height fitted to that box. */
+static void png_view(const sph_sim *sim, sph_view *v) {
+  const sph_scene *s = sim->scene;
+  const sph_png_output *o = &s->output.png;
+  const sph_camera *c = &o->camera;
+  double lo[3] = {INFINITY, INFINITY, INFINITY};
+  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+  for (size_t a = 0; a < sim->ps->n; ++a)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = fmin(lo[k], X[3 * a + k]);
+      hi[k] = fmax(hi[k], X[3 * a + k]);
+    }
+  for (int k = 0; k < 3; ++k) {
+    double pad = 0.5 * sim->dp + 0.1 * (hi[k] - lo[k]);
+    lo[k] -= pad;
+    hi[k] += pad;
+  }
+  sph_view_fit(lo, hi, c->given ? c->azimuth : 30.0,
+               c->given ? c->elevation : 20.0, c->given ? c->zoom : 1.0,
+               c->given ? c->orthographic : 0, s->dimension, o->width,
+               o->height, v);
+  if (!(c->given && c->has_position))
+    return;
+  memcpy(v->eye, c->position, sizeof c->position);
+  memcpy(v->target, c->target, sizeof c->target);
+  memcpy(v->up, c->up, sizeof c->up);
+  /* basis of the given camera; a degenerate one is left to sph_view_check */
+  double f[3], r[3], u[3];
+  for (int k = 0; k < 3; ++k)
+    f[k] = v->target[k] - v->eye[k];
+  double fl = sqrt(dot3(f, f));
+  if (!(fl > 0.0))
+    return;
+  for (int k = 0; k < 3; ++k)
+    f[k] /= fl;
+  r[0] = f[1] * v->up[2] - f[2] * v->up[1];
+  r[1] = f[2] * v->up[0] - f[0] * v->up[2];
+  r[2] = f[0] * v->up[1] - f[1] * v->up[0];
+  double rl = sqrt(dot3(r, r));
+  if (!(rl > 0.0))
+    return;
+  for (int k = 0; k < 3; ++k)
+    r[k] /= rl;
+  u[0] = r[1] * f[2] - r[2] * f[1];
+  u[1] = r[2] * f[0] - r[0] * f[2];
+  u[2] = r[0] * f[1] - r[1] * f[0];
+  /* depth range and half height of the box's corners seen from the eye */
+  double dmin = INFINITY, dmax = -INFINITY, half = 0.0;
+  double aspect = (double)o->width / o->height;
+  for (int i = 0; i < 8; ++i) {
+    double q[3] = {i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1],
+                   i & 4 ? hi[2] : lo[2]};
+    double e[3] = {q[0] - v->eye[0], q[1] - v->eye[1], q[2] - v->eye[2]};
+    double t[3] = {q[0] - v->target[0], q[1] - v->target[1],
+                   q[2] - v->target[2]};
+    dmin = fmin(dmin, dot3(e, f));
+    dmax = fmax(dmax, dot3(e, f));
+    half = fmax(half, fmax(fabs(dot3(t, u)), fabs(dot3(t, r)) / aspect));
+  }
+  /* only what lies in front of the eye, in either projection */
+  double pad = 0.05 * (dmax - dmin) + sim->dp;
+  if (v->ortho && half > 0.0)
+    v->ortho_height = 2.0 * 1.05 * half / (c->zoom > 0.0 ? c->zoom : 1.0);
+  if (dmax + pad > 0.0) {
+    v->far_clip = dmax + pad;
+    v->near_clip = fmax(dmin - pad, v->ortho ? 0.0 : 1e-3 * v->far_clip);
+  }
+}
+
+/* cut: half: per body, the particles behind its reference centroid along
+ * the coordinate axis closest to the view direction (a flat cut face on
+ * lattice bodies, looking at the camera; keep[a] = 1); all otherwise. */
+static sph_status cut_mask(const sph_sim *sim, const sph_view *v,
+                           unsigned char *keep, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_particles *ps = sim->ps;
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  memset(keep, 1, ps->n);
+  if (!s->output.png.cut_half)
+    return SPH_OK;
+  double *c = calloc(4 * (s->nbodies ? s->nbodies : 1), sizeof *c);
+  if (!c)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  for (size_t a = 0; a < ps->n; ++a) {
+    double *cb = c + 4 * ps->body[a];
+    for (int k = 0; k < 3; ++k)
+      cb[k] += X[3 * a + k];
+    cb[3] += 1.0;
+  }
+  int axis = 0;
+  double f[3];
+  for (int k = 0; k < 3; ++k) {
+    f[k] = v->target[k] - v->eye[k];
+    axis = fabs(f[k]) > fabs(f[axis]) ? k : axis;
+  }
+  double sign = f[axis] < 0.0 ? -1.0 : 1.0, tol = 1e-6 * sim->dp;
+  for (size_t a = 0; a < ps->n; ++a) {
+    const double *cb = c + 4 * ps->body[a];
+    keep[a] = sign * (X[3 * a + axis] - cb[axis] / cb[3]) >= -tol;
+  }
+  free(c);
+  return SPH_OK;
+}
+
+/* The png block's child `key` (or the block itself when the key is absent,
+ * NULL without a block): where errors about the frames point. */
+static const sph_node *png_node(const sph_scene *s, const char *key) {
+  const sph_node *n = s->root ? sph_node_child(s->root, "output") : NULL;
+  n = n ? sph_node_child(n, "png") : NULL;
+  const sph_node *k = n && key ? sph_node_child(n, key) : NULL;
+  return k ? k : n;
+}
+
+/* An error at node n, or without a location when there is none. */
+static sph_status png_error(const sph_node *n, sph_error *err,
+                            const char *msg) {
+  if (n)
+    return sph_node_error(n, err, SPH_ERR_RANGE, "%s", msg);
+  return sph_error_set(err, SPH_ERR_RANGE, "output.png: %s", msg);
+}
+
+sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_png_output *o = &s->output.png;
+  if (!o->enabled)
+    return SPH_OK;
+  const sph_particles *ps = sim->ps;
+  const sph_node *cam = png_node(s, "camera");
+  char msg[1024];
+  sph_view v;
+  png_view(sim, &v);
+  sph_error verr;
+  if (sph_view_check(&v, &verr) != SPH_OK) {
+    snprintf(msg, sizeof msg, "unusable camera (%s)", verr.message);
+    return png_error(cam, err, msg);
+  }
+  /* an eye inside a body would see the particles from within */
+  for (size_t b = 0; s->dimension == 3 && b < s->nbodies; ++b)
+    if (sph_shape_distance(&s->bodies[b].shape, 3, v.eye) < 0.0) {
+      const sph_node *pos = cam ? sph_node_child(cam, "position") : NULL;
+      snprintf(msg, sizeof msg,
+               "the camera at (%g, %g, %g) is inside body '%s'; place it "
+               "outside every body",
+               v.eye[0], v.eye[1], v.eye[2], s->bodies[b].name);
+      return png_error(pos ? pos : cam, err, msg);
+    }
+  /* something left after the cutaways, and something of it in view */
+  unsigned char *keep = malloc(ps->n ? ps->n : 1);
+  if (!keep)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png check");
+  sph_status st = cut_mask(sim, &v, keep, err);
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  size_t kept = 0, seen = 0;
+  for (size_t a = 0; st == SPH_OK && a < ps->n && !seen; ++a) {
+    if (!keep[a] || (o->clip && dot3(o->clip_normal, X + 3 * a) > o->clip_at))
+      continue;
+    ++kept;
+    double w[3];
+    seen += sph_view_project(&v, o->width, o->height, X + 3 * a, w) &&
+            w[0] >= 0.0 && w[0] < o->width && w[1] >= 0.0 && w[1] < o->height &&
+            w[2] >= 0.0 && w[2] <= 1.0;
+  }
+  free(keep);
+  if (st != SPH_OK)
+    return st;
+  if (ps->n > 0 && kept == 0) {
+    snprintf(msg, sizeof msg, "the clip plane keeps none of the %zu particles",
+             ps->n);
+    return png_error(png_node(s, "clip"), err, msg);
+  }
+  if (kept > 0 && seen == 0) {
+    snprintf(msg, sizeof msg,
+             "the camera at (%g, %g, %g) looking at (%g, %g, %g) sees none "
+             "of the %zu particles; aim it at the bodies",
+             v.eye[0], v.eye[1], v.eye[2], v.target[0], v.target[1],
+             v.target[2], kept);
+    return png_error(cam, err, msg);
+  }
+  return SPH_OK;
+}
+
+/* The reference outline (ghost): a flat light grey silhouette of spheres of
+ * radius 0.72 dp (closing the lattice gaps) over one of 0.84 dp in a darker
+ * grey, which leaves a rim around the reference shape. */
+static const unsigned char ghost_fill[3] = {222, 222, 226};
+static const unsigned char ghost_rim[3] = {168, 170, 178};
+#define GHOST_FILL 0.72
+#define GHOST_RIM 0.84
 
 static sph_status png_open(sph_sink *sink, const sph_sim *sim, const char *dir,
                            sph_error *err) {
@@ -66,7 +277,8 @@ static sph_status png_open(sph_sink *sink, const sph_sim *sim, const char *dir,
   p->xyz = malloc(3 * n * sizeof *p->xyz);
   p->rgb = malloc(3 * n);
   p->value = malloc(n * sizeof *p->value);
-  if (!p->xyz || !p->rgb || !p->value)
+  p->keep = malloc(n);
+  if (!p->xyz || !p->rgb || !p->value || !p->keep)
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   SPH_TRY(sph_image_create(&p->img, o->width, o->height, err));
   SPH_TRY(sph_gl_create(o->width, o->height, &p->gl, err));
@@ -83,31 +295,35 @@ static sph_status png_open(sph_sink *sink, const sph_sim *sim, const char *dir,
   int signed_field = sph_field_components(f) == 1 &&
                      (p->symmetric || (p->fixed && p->lo < 0.0 && p->hi > 0.0));
   p->map = signed_field ? SPH_CMAP_COOL_WARM : SPH_CMAP_VIRIDIS;
-  /* camera: the scene's, or a fit of the initial bounding box */
-  const sph_camera *c = &o->camera;
-  double lo[3] = {INFINITY, INFINITY, INFINITY};
-  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+  /* camera, cutaways and the reference outline */
+  png_view(sim, &p->view);
+  SPH_TRY(sph_view_check(&p->view, err));
+  SPH_TRY(cut_mask(sim, &p->view, p->keep, err));
   for (size_t a = 0; a < sim->ps->n; ++a)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = fmin(lo[k], X[3 * a + k]);
-      hi[k] = fmax(hi[k], X[3 * a + k]);
+    p->nkeep += p->keep[a];
+  for (int k = 0; k < 3; ++k)
+    p->plane[k] = -o->clip_normal[k];
+  p->plane[3] = o->clip_at;
+  if (o->ghost) {
+    const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+    p->ghost_xyz = malloc(3 * n * sizeof *p->ghost_xyz);
+    p->ghost_rim = malloc(3 * n);
+    p->ghost_fill = malloc(3 * n);
+    if (!p->ghost_xyz || !p->ghost_rim || !p->ghost_fill)
+      return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+    size_t m = 0;
+    for (size_t a = 0; a < sim->ps->n; ++a) {
+      if (!p->keep[a])
+        continue;
+      for (int k = 0; k < 3; ++k) {
+        p->ghost_xyz[3 * m + k] = (float)X[3 * a + k];
+        p->ghost_rim[3 * m + k] = ghost_rim[k];
+        p->ghost_fill[3 * m + k] = ghost_fill[k];
+      }
+      ++m;
     }
-  for (int k = 0; k < 3; ++k) {
-    double pad = 0.5 * sim->dp + 0.1 * (hi[k] - lo[k]);
-    lo[k] -= pad;
-    hi[k] += pad;
   }
-  sph_view_fit(lo, hi, c->given ? c->azimuth : 30.0,
-               c->given ? c->elevation : 20.0, c->given ? c->zoom : 1.0,
-               c->given ? c->orthographic : 0, s->dimension, o->width,
-               o->height, &p->view);
-  if (c->given && c->has_position) {
-    memcpy(p->view.eye, c->position, sizeof c->position);
-    memcpy(p->view.target, c->target, sizeof c->target);
-    memcpy(p->view.up, c->up, sizeof c->up);
-  }
-  return sph_view_check(&p->view, err);
+  return SPH_OK;
 }
 
 static sph_status png_write(sph_sink *sink, const sph_frame *fr,
@@ -129,8 +345,6 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
       vmax = fmax(vmax, v);
       amax = fmax(amax, fabs(v));
     }
-    for (int c = 0; c < 3; ++c)
-      p->xyz[3 * a + c] = (float)x[3 * a + c];
   }
   /* grow-only range from the frames with a varying field */
   if (!p->fixed && vmax > vmin) {
@@ -144,17 +358,33 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
   int clamped_low = 0, clamped_high = 0;
   for (size_t a = 0; a < n; ++a) {
     double v = p->value[a];
-    if (!isfinite(v)) {
-      sph_colormap_nan(p->map, p->rgb + 3 * a);
+    if (!isfinite(v))
       continue;
-    }
     clamped_low |= v < lo;
     clamped_high |= v > hi;
-    sph_colormap_eval(p->map, (v - lo) / (hi - lo), p->rgb + 3 * a);
   }
-  float radius = (float)(0.5 * fr->sim->dp);
-  SPH_TRY(sph_gl_draw_spheres(p->gl, &p->view, n, p->xyz, radius, p->rgb, NULL,
-                              &p->img, err));
+  /* the kept particles, packed in index order */
+  size_t m = 0;
+  for (size_t a = 0; a < n; ++a) {
+    if (!p->keep[a])
+      continue;
+    for (int c = 0; c < 3; ++c)
+      p->xyz[3 * m + c] = (float)x[3 * a + c];
+    double v = p->value[a];
+    if (isfinite(v))
+      sph_colormap_eval(p->map, (v - lo) / (hi - lo), p->rgb + 3 * m);
+    else
+      sph_colormap_nan(p->map, p->rgb + 3 * m);
+    ++m;
+  }
+  double dp = fr->sim->dp;
+  const double *plane = o->clip ? p->plane : NULL;
+  size_t ng = o->ghost ? p->nkeep : 0;
+  sph_gl_layer layers[3] = {
+      {ng, p->ghost_xyz, (float)(GHOST_RIM * dp), p->ghost_rim, plane, 1},
+      {ng, p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1},
+      {m, p->xyz, (float)(0.5 * dp), p->rgb, plane, 0}};
+  SPH_TRY(sph_gl_draw_layers(p->gl, &p->view, layers, 3, &p->img, err));
   /* overlay: colour bar at the right, label block at the top left */
   int H = p->img.height, W = p->img.width;
   char title[96], label[256];
@@ -172,6 +402,9 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
                      .y = H / 5,
                      .width = W / 48 > 8 ? W / 48 : 8,
                      .height = 3 * H / 5};
+  int fit = W - (W / 64 > 4 ? W / 64 : 4) -
+            sph_colorbar_extent(&p->img, p->text, &cb);
+  cb.x = fit < cb.x ? fit : cb.x; /* labels inside small frames */
   sph_colorbar_draw(&p->img, p->text, &cb);
   snprintf(label, sizeof label, "%s\nt = %.5f s", p->name, fr->time);
   sph_overlay_label(&p->img, p->text, W / 64, H / 36, label);
@@ -192,6 +425,10 @@ static void png_destroy(sph_sink *sink) {
   free(p->xyz);
   free(p->rgb);
   free(p->value);
+  free(p->keep);
+  free(p->ghost_xyz);
+  free(p->ghost_rim);
+  free(p->ghost_fill);
   free(p);
   sink->data = NULL;
 }

@@ -1,11 +1,39 @@
-/* The off-screen renderer's sink (render/png_sink.c): pressure-coloured
- * sphere frames, frames/<scene>_NNNN.png, created only when the scene has
- * an `output.png` block. */
+/* The off-screen renderer's outputs: the PNG sink (render/png_sink.c),
+ * pressure-coloured sphere frames, frames/<scene>_NNNN.png, created only
+ * when the scene has an `output.png` block; its pre-run check; and the mp4
+ * assembled from the frames by ffmpeg after the run (render/mp4.c). */
 #ifndef SPH_RENDER_H
 #define SPH_RENDER_H
 
+#include "sph/sim.h"
 #include "sph/sink.h"
+#include "sph/status.h"
 
 extern const sph_sink_ops sph_png_sink_ops;
+
+/* Checks, before anything is written, that the scene's png block can give
+ * a picture: a usable camera, not inside a body (3D), a clip/cut that keeps
+ * some particle, and at least one kept initial particle whose centre
+ * projects inside the frame. Errors name the key (output.png.camera,
+ * .camera.position or .clip) with file:line:col. SPH_OK without a block. */
+sph_status sph_png_check(const sph_sim *sim, sph_error *err);
+
+/* What sph_mp4_assemble did. */
+typedef struct sph_mp4_info {
+  char path[1100]; /* <dir>/<scene>.mp4 */
+  char codec[16];  /* libx264, or mpeg4 when ffmpeg lacks libx264 */
+  int frames;
+  double seconds; /* wall time of ffmpeg */
+} sph_mp4_info;
+
+/* Assembles <dir>/frames/<scene>_0000.png .. _<frames-1>.png into
+ * <dir>/<scene>.mp4 with the ffmpeg found on PATH: H.264 (libx264, else
+ * MPEG-4 part 2), yuv420p, dimensions padded to even, `fps` frames per
+ * second. ffmpeg writes <scene>.mp4.part (forced mp4 container), which is
+ * renamed on success and removed on failure. SPH_ERR_UNSUPPORTED when no
+ * ffmpeg is on PATH; SPH_ERR_IO when it fails (the message carries ffmpeg's
+ * last error line). ffmpeg's output never reaches the terminal. */
+sph_status sph_mp4_assemble(const char *dir, const char *scene, int frames,
+                            double fps, sph_mp4_info *info, sph_error *err);
 
 #endif

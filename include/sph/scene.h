@@ -144,6 +144,12 @@ typedef struct sph_png_output {
   char range_mode[16]; /* auto | symmetric | fixed | global */
   double range[2];
   sph_camera camera;
+  int mp4;    /* assemble <scene>.mp4 from the frames after the run */
+  double fps; /* its frame rate */
+  int clip;   /* draw only particles with clip_normal . x <= clip_at */
+  double clip_normal[3], clip_at;
+  int cut_half; /* per body, only the half behind its reference centroid */
+  int ghost;    /* the reference configuration drawn behind the frame */
 } sph_png_output;
 
 typedef struct sph_output {

@@ -38,6 +38,8 @@ struct sph_sink {
   /* > 0 when resuming: frames 0 .. resume_frames - 1 exist already and the
    * sink continues after them */
   int resume_frames;
+  /* wall time spent in its hooks (kept by the caller; summary.json) */
+  double seconds;
 };
 
 /* energy.csv: time, energies, linear and angular momentum */

@@ -41,7 +41,7 @@ static int file_exists(const char *dir, const char *name) {
 }
 
 /* Removes only the files an earlier run of ours wrote. */
-static void remove_previous(const char *dir) {
+static void remove_previous(const char *dir, const char *scene) {
   static const char *const names[] = {
       "summary.json",    "energy.csv",        "probes.csv",
       "scene_used.yaml", SPH_CHECKPOINT_FILE, SPH_CHECKPOINT_PREVIOUS,
@@ -59,6 +59,26 @@ static void remove_previous(const char *dir) {
         (len > 4 && !strcmp(e->d_name + len - 4, ".pvd"))) {
       snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
       remove(path);
+    }
+  }
+  if (d)
+    closedir(d);
+  /* the animation and frames/<scene>_NNNN.png */
+  snprintf(path, sizeof path, "%s/%s.mp4", dir, scene);
+  remove(path);
+  snprintf(path, sizeof path, "%s/%s.mp4.part", dir, scene);
+  remove(path);
+  char frames[1100], fpath[1400];
+  snprintf(frames, sizeof frames, "%s/frames", dir);
+  size_t prefix = strlen(scene);
+  d = opendir(frames);
+  while (d && (e = readdir(d))) {
+    const char *rest = e->d_name + prefix;
+    if (!strncmp(e->d_name, scene, prefix) && rest[0] == '_' &&
+        strspn(rest + 1, "0123456789") == 4 &&
+        (!strcmp(rest + 5, ".png") || !strcmp(rest + 5, ".png.part"))) {
+      snprintf(fpath, sizeof fpath, "%s/%s", frames, e->d_name);
+      remove(fpath);
     }
   }
   if (d)
@@ -101,6 +121,16 @@ static sph_status write_scene_used(const sph_scene *s, const char *dir,
   return st;
 }
 
+/* One line: the wall time of each sink and its share of the run's. */
+static void print_sink_times(const sph_sink *sinks, int nsinks, double wall) {
+  printf("outputs:");
+  for (int i = 0; i < nsinks; ++i)
+    printf("%s %s %.2f s (%.1f %%)", i ? "," : "", sinks[i].ops->name,
+           sinks[i].seconds,
+           wall > 0.0 ? 100.0 * sinks[i].seconds / wall : 0.0);
+  printf(" of %.2f s wall\n", wall);
+}
+
 /* derive, then every sink and the verdict see the same frame */
 static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
                                sph_verdict *v, int index, sph_error *err) {
@@ -113,8 +143,11 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
                   .sim = sim,
                   .ps = sim->ps};
   sim->method->energy(sim, &fr.kinetic, &fr.strain);
-  for (int i = 0; i < nsinks && st == SPH_OK; ++i)
+  for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+    double t0 = sph_wtime();
     st = sinks[i].ops->write(&sinks[i], &fr, err);
+    sinks[i].seconds += sph_wtime() - t0;
+  }
   if (st == SPH_OK)
     st = sph_verdict_observe(v, &fr, err);
   return st;
@@ -166,7 +199,7 @@ int sph_cmd_run(int argc, char **argv) {
     return SPH_EXIT_USAGE;
   }
   if (args.overwrite && !args.resume)
-    remove_previous(dir);
+    remove_previous(dir, scene->name);
   if (!args.quiet)
     banner(sim, dir);
 
@@ -200,8 +233,10 @@ int sph_cmd_run(int argc, char **argv) {
   if (st == SPH_OK)
     st = write_scene_used(scene, dir, &err);
   for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+    double t0 = sph_wtime();
     sinks[i].resume_frames = index;
     st = sinks[i].ops->open(&sinks[i], sim, dir, &err);
+    sinks[i].seconds += sph_wtime() - t0;
   }
 
   sph_progress prog;
@@ -228,8 +263,11 @@ int sph_cmd_run(int argc, char **argv) {
     if (st == SPH_OK && sim->t >= next_ckpt - eps && sim->t < t_end - eps) {
       /* rows before the checkpoint reach the disk first */
       for (int i = 0; i < nsinks && st == SPH_OK; ++i)
-        if (sinks[i].ops->flush)
+        if (sinks[i].ops->flush) {
+          double t0 = sph_wtime();
           st = sinks[i].ops->flush(&sinks[i], &err);
+          sinks[i].seconds += sph_wtime() - t0;
+        }
       if (st == SPH_OK)
         st = sph_checkpoint_write(dir, sim, verdict, index, &err);
       next_ckpt += ckpt * floor((sim->t - next_ckpt) / ckpt + 1.0);
@@ -251,6 +289,7 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error cerr;
   int io_failed = st == SPH_ERR_IO;
   for (int i = 0; i < nsinks; ++i) {
+    double t0 = sph_wtime();
     if (sinks[i].data && !io_failed &&
         sinks[i].ops->close(&sinks[i], &cerr) != SPH_OK) {
       io_failed = 1;
@@ -258,12 +297,23 @@ int sph_cmd_run(int argc, char **argv) {
     }
     if (sinks[i].ops->destroy)
       sinks[i].ops->destroy(&sinks[i]);
+    sinks[i].seconds += sph_wtime() - t0;
   }
+  /* the animation of the frames, once the run has ended */
+  sph_mp4_info mp4 = {0};
+  sph_error merr;
+  sph_status mst = SPH_OK;
+  int mp4_tried = scene->output.png.enabled && scene->output.png.mp4 &&
+                  !io_failed && index > 0;
+  if (mp4_tried)
+    mst = sph_mp4_assemble(dir, scene->name, index, scene->output.png.fps, &mp4,
+                           &merr);
   if (verdict && !io_failed) {
     char spath[1200];
     snprintf(spath, sizeof spath, "%s/summary.json", dir);
-    if (sph_summary_write(spath, sim, verdict, wall, completed, &cerr) !=
-        SPH_OK) {
+    if (sph_summary_write(spath, sim, verdict, wall, sinks, nsinks,
+                          mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
+                          completed, &cerr) != SPH_OK) {
       io_failed = 1;
       err = cerr;
     }
@@ -280,6 +330,18 @@ int sph_cmd_run(int argc, char **argv) {
            sim->steps, wall,
            wall > 0 ? (double)sim->steps * (double)sim->ps->n / wall : 0.0);
     rc = SPH_EXIT_OK;
+  }
+  if (!io_failed && !args.quiet)
+    print_sink_times(sinks, nsinks, wall);
+  if (mp4_tried && mst == SPH_OK)
+    printf("mp4: %s (%d frames, %s, %.1f s)\n", mp4.path, mp4.frames, mp4.codec,
+           mp4.seconds);
+  else if (mp4_tried && mst == SPH_ERR_UNSUPPORTED)
+    printf("mp4 skipped: ffmpeg not found\n");
+  else if (mp4_tried) {
+    char msg[1024];
+    sph_error_format(&merr, msg, sizeof msg);
+    fprintf(stderr, "sph: warning: no mp4: %s\n", msg);
   }
   sph_verdict_destroy(verdict);
   sph_sim_destroy(sim);

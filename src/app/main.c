@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "app/app_impl.h"
+#include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
 
@@ -113,7 +114,11 @@ int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
   if (st == SPH_OK)
     st = sph_sim_create(sim, *scene, &err);
   if (st == SPH_OK)
+    st = sph_png_check(*sim, &err);
+  if (st == SPH_OK)
     return SPH_EXIT_OK;
+  sph_sim_destroy(*sim);
+  *sim = NULL;
   sph_app_print_error(&err);
   sph_scene_destroy(*scene);
   *scene = NULL;

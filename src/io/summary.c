@@ -30,7 +30,9 @@ static void json_number(FILE *f, double x) {
 
 sph_status sph_summary_write(const char *path, const sph_sim *sim,
                              const sph_verdict *v, double wall_seconds,
-                             int completed, sph_error *err) {
+                             const sph_sink *sinks, int nsinks,
+                             double mp4_seconds, int completed,
+                             sph_error *err) {
   sph_atomic_file af;
   sph_status st = sph_atomic_open(&af, path, err);
   if (st != SPH_OK)
@@ -59,6 +61,19 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     json_string(f, sim->terms[i].ops->name);
     fputs(": ", f);
     json_number(f, sim->terms[i].seconds);
+  }
+  fputs("},\n  \"sinks\": {", f);
+  for (int i = 0; i < nsinks; ++i) {
+    fputs(i ? ", " : "", f);
+    json_string(f, sinks[i].ops->name);
+    fputs(": ", f);
+    json_number(f, sinks[i].seconds);
+  }
+  if (mp4_seconds >= 0.0) {
+    fputs(nsinks ? ", " : "", f);
+    json_string(f, "mp4");
+    fputs(": ", f);
+    json_number(f, mp4_seconds);
   }
   fprintf(f, "},\n  \"particles\": %zu,\n  \"steps\": %lu,\n", sim->ps->n,
           sim->steps);

@@ -706,8 +706,9 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   sph_png_output *p = &s->output.png;
   if (!png)
     return SPH_OK;
-  static const char *const keys[] = {"width", "height", "color",
-                                     "range", "camera", NULL};
+  static const char *const keys[] = {"width",  "height", "color", "range",
+                                     "camera", "mp4",    "fps",   "clip",
+                                     "cut",    "ghost",  NULL};
   SPH_TRY(sph_node_check_keys(png, keys, err));
   p->enabled = 1;
   long w, h;
@@ -780,6 +781,35 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
                             "projection is orthographic or perspective");
     c->orthographic = !strcmp(proj, "orthographic");
   }
+  /* the animation, the cutaway and the reference outline */
+  SPH_TRY(sph_node_get_bool(png, "mp4", 0, 1, &p->mp4, err));
+  SPH_TRY(positive(png, "fps", 0, 30.0, &p->fps, err));
+  if (p->fps > 240.0)
+    return sph_node_error(sph_node_child(png, "fps"), err, SPH_ERR_RANGE,
+                          "fps must be in (0, 240], got %g", p->fps);
+  sph_node *clip;
+  SPH_TRY(sph_node_get_map(png, "clip", 0, &clip, err));
+  if (clip) {
+    static const char *const pkeys[] = {"normal", "at", NULL};
+    SPH_TRY(sph_node_check_keys(clip, pkeys, err));
+    SPH_TRY(
+        sph_node_get_doubles(clip, "normal", 1, 3, p->clip_normal, NULL, err));
+    SPH_TRY(sph_node_get_double(clip, "at", 1, 0.0, &p->clip_at, err));
+    double nn = 0.0;
+    for (int k = 0; k < 3; ++k)
+      nn += p->clip_normal[k] * p->clip_normal[k];
+    if (!(nn > 0.0) || !isfinite(nn))
+      return sph_node_error(sph_node_child(clip, "normal"), err, SPH_ERR_RANGE,
+                            "the clip normal must be a non-zero vector");
+    p->clip = 1;
+  }
+  const char *cut;
+  SPH_TRY(sph_node_get_string(png, "cut", 0, "none", &cut, err));
+  if (strcmp(cut, "none") && strcmp(cut, "half"))
+    return sph_node_error(sph_node_child(png, "cut"), err, SPH_ERR_RANGE,
+                          "cut is none or half, got '%s'", cut);
+  p->cut_half = !strcmp(cut, "half");
+  SPH_TRY(sph_node_get_bool(png, "ghost", 0, 0, &p->ghost, err));
   return SPH_OK;
 }
 

@@ -1,8 +1,9 @@
 /* OSMesa sphere renderer: disc size and shading of one sphere (ortho and
  * perspective, also 400 px wide), top-first rows, depth-correct occlusion in
- * either draw order, the clip plane, byte-identical repeat frames, the
- * camera fit, argument errors and the refused swrast driver; writes
- * gl_demo_lattice.ppm to the build directory. */
+ * either draw order, layers painted over one another (flat colours), the
+ * clip plane, byte-identical repeat frames, the camera fit, argument errors
+ * and the refused swrast driver; writes gl_demo_lattice.ppm to the build
+ * directory. */
 #include "test_util.h"
 
 #include <math.h>
@@ -191,6 +192,43 @@ START_TEST(occlusion_any_order) {
   sph_gl_destroy(gl);
   free(a.rgba);
   free(b.rgba);
+}
+END_TEST
+
+START_TEST(layers_paint_over) {
+  /* layer 0: a flat grey sphere nearer the eye (z = 0.5) than layer 1's
+   * shaded red one (z = 0), overlapping around x = 0; the later layer
+   * covers the earlier one whatever their depths */
+  const float grey_c[3] = {-0.2f, 0.0f, 0.5f}, red_c[3] = {0.2f, 0.0f, 0.0f};
+  const unsigned char grey[3] = {200, 201, 202}, red[3] = {230, 40, 30};
+  sph_gl *gl = context(200, 200);
+  sph_image img = image_new(200, 200);
+  sph_view v = front_view(1, 2.0, 5.0);
+  sph_gl_layer layers[2] = {{1, grey_c, 0.5f, grey, NULL, 1},
+                            {1, red_c, 0.5f, red, NULL, 0}};
+  sph_error err;
+  ck_assert_int_eq(sph_gl_draw_layers(gl, &v, layers, 2, &img, &err), SPH_OK);
+  int red_px = 0;
+  for (int x = 88; x <= 112; ++x) {
+    const unsigned char *p = px(&img, x, 100);
+    red_px += p[0] > p[2] + 80;
+  }
+  ck_assert_msg(red_px == 25, "red in %d of 25 overlap pixels", red_px);
+  /* the flat layer keeps its exact colour where it shows (x = -0.55) */
+  double o[3];
+  const double left[3] = {-0.55, 0.0, 0.0};
+  ck_assert(sph_view_project(&v, 200, 200, left, o));
+  const unsigned char *g = px(&img, (int)o[0], (int)o[1]);
+  ck_assert(g[0] == 200 && g[1] == 201 && g[2] == 202);
+  /* one layer is sph_gl_draw_spheres, byte for byte */
+  sph_image one = image_new(200, 200);
+  draw(gl, &v, 1, red_c, 0.5f, red, NULL, &one);
+  ck_assert_int_eq(sph_gl_draw_layers(gl, &v, layers + 1, 1, &img, &err),
+                   SPH_OK);
+  ck_assert(memcmp(one.rgba, img.rgba, (size_t)200 * 200 * 4) == 0);
+  sph_gl_destroy(gl);
+  free(img.rgba);
+  free(one.rgba);
 }
 END_TEST
 
@@ -403,6 +441,7 @@ int main(void) {
   tcase_add_test(tc, one_sphere_perspective);
   tcase_add_test(tc, large_sphere);
   tcase_add_test(tc, occlusion_any_order);
+  tcase_add_test(tc, layers_paint_over);
   tcase_add_test(tc, clip_plane);
   tcase_add_test(tc, repeatable_and_demo);
   tcase_add_test(tc, fit_frames_box);

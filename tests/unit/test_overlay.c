@@ -1,7 +1,7 @@
 /* Overlay: colour map end points and lightness, nice ticks and their labels,
  * FreeType text (width, ink box, clipping, repeatability, missing fonts),
- * the colour bar's end colours and tick-label alignment, and a composed demo
- * frame written as PPM to the build directory (overlay_demo.ppm, with the
+ * the colour bar's end colours, tick-label alignment and extent, and a composed
+ * demo frame written as PPM to the build directory (overlay_demo.ppm, with the
  * viridis test bar in overlay_colorbar_viridis.ppm). */
 #include "test_util.h"
 
@@ -419,6 +419,34 @@ START_TEST(colorbar_ends) {
 }
 END_TEST
 
+START_TEST(colorbar_extent) {
+  /* the ink of a bar placed by its extent ends inside the image, at most a
+   * few pixels short of the extent (glyph side bearings) */
+  sph_text *t = open_font();
+  sph_image img = image_new(320, 240, 255);
+  sph_colorbar cb = {.map = SPH_CMAP_COOL_WARM,
+                     .min = -4.3e6,
+                     .max = 4.3e6,
+                     .y = 48,
+                     .width = 8,
+                     .height = 144};
+  int ext = sph_colorbar_extent(&img, t, &cb);
+  ck_assert_int_gt(ext, cb.width + 20);
+  cb.x = img.width - 5 - ext;
+  sph_colorbar_draw(&img, t, &cb);
+  int right = -1;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (!near_rgb(pixel(&img, x, y), 255, 255, 255, 0))
+        right = x > right ? x : right;
+  ck_assert_msg(right < cb.x + ext && right >= cb.x + ext - 4 &&
+                    right < img.width - 4,
+                "ink ends at %d, bar %d + extent %d", right, cb.x, ext);
+  free(img.rgba);
+  sph_text_destroy(t);
+}
+END_TEST
+
 START_TEST(demo_frame) {
   /* a stand-in for a rendered frame: a shaded "column" coloured by a
    * pressure-like field, with the colour bar and the label block on top */
@@ -479,6 +507,7 @@ int main(void) {
   tcase_add_test(tc, text_repeatable);
   tcase_add_test(tc, font_missing);
   tcase_add_test(tc, colorbar_ends);
+  tcase_add_test(tc, colorbar_extent);
   tcase_add_test(tc, demo_frame);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
