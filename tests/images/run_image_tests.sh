@@ -69,6 +69,8 @@ image_case() {
 image_case twisting_column scenes/twisting_column.yaml --set "bodies.0.particles.count=[5, 25, 5]" --set time.end=0.2 --set output.every=0.1
 # A4 punch, 21x11x3, t = 0, 0.007, 0.014 s, seen from the front
 image_case punch scenes/punch.yaml --set "bodies.0.particles.count=[21, 11, 3]" --set time.end=0.014 --set output.every=0.007 --set "output.png.camera={azimuth: 15, elevation: 10, zoom: 0.7}"
+# A8 colliding rings (ul-sph, ENOG), dp 0.002, t = 0, 0.003, 0.006 s
+image_case colliding_rings scenes/colliding_rings.yaml --set bodies.0.particles.spacing=0.002 --set bodies.1.particles.spacing=0.002 --set time.end=0.006 --set output.every=0.003
 
 echo "$fails failed"
 [ $fails -eq 0 ]
