@@ -62,6 +62,14 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     fputs(": ", f);
     json_number(f, sim->terms[i].seconds);
   }
+  /* how often each part ran (ul-sph: configuration updates are its
+   * advection steps) */
+  fputs("},\n  \"calls\": {", f);
+  for (int i = 0; i < sim->ntimers; ++i) {
+    fputs(i ? ", " : "", f);
+    json_string(f, sim->timers[i].name);
+    fprintf(f, ": %lu", sim->timers[i].calls);
+  }
   fputs("},\n  \"sinks\": {", f);
   for (int i = 0; i < nsinks; ++i) {
     fputs(i ? ", " : "", f);

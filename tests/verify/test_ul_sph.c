@@ -1,9 +1,9 @@
 /* ul-sph (seed 002): pair interactions (Riemann solver symmetry and limiter,
  * exact velocity gradient of a linear field with the correction matrix of
  * eq. 31, zero Laplacian force of a rigid rotation, eq. 23), the B4 plate
- * period against seed 002 Table 1, dual against single time stepping, the
- * A8 rings at 0.08 c0 (no fracture with ENOG, fracture with OG, initial
- * kinetic energy), and the B7 spinning plate momentum. */
+ * period against seed 002 Table 1 at H/dp = 10 and 20, dual against single
+ * time stepping, the A8 rings at 0.08 c0 (no fracture with ENOG, fracture
+ * with OG, initial kinetic energy), and the B7 spinning plate momentum. */
 #include "test_util.h"
 
 #include <math.h>
@@ -188,6 +188,19 @@ START_TEST(plate_period_and_stepping) {
 }
 END_TEST
 
+/* B4 at H/dp = 20 (the same 0.008 m root, 8 layers) */
+START_TEST(plate_period_refined) {
+  const char *fine[] = {"bodies.0.particles.spacing=0.001"};
+  plate_result d = plate(fine, 1);
+  printf("B4 H/dp 20, v_f 0.01: period %.5f (%lu acoustic steps, %lu "
+         "configuration updates), energy drift over a period %.2e\n",
+         d.period, d.steps, d.updates, (d.e1 - d.e0) / d.e0);
+  ck_assert_msg(fabs(d.period - 0.263) < 0.05 * 0.263, "period %g", d.period);
+  ck_assert_msg(d.e1 <= d.e0 && d.e1 > 0.99 * d.e0, "energy %g -> %g", d.e0,
+                d.e1);
+}
+END_TEST
+
 typedef struct rings_result {
   double ke0, max_stretch, vx_end;
   int pairs_over;
@@ -323,6 +336,7 @@ int main(void) {
   tcase_set_timeout(run, 600);
   tcase_add_checked_fixture(run, sph_test_enable_fp_traps, NULL);
   tcase_add_test(run, plate_period_and_stepping);
+  tcase_add_test(run, plate_period_refined);
   tcase_add_test(run, rings_enog_bounce_without_fracture);
   tcase_add_test(run, rings_og_fracture);
   tcase_add_test(run, spinning_plate_momentum);
