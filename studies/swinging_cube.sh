@@ -8,6 +8,6 @@ cd "$(dirname "$0")/.."
 sph=${SPH:-./build/sph}
 jst='name: tl-jst, jst: {eps2_p: 0, eps4_p: 0.125}, angular_momentum_projection: false, jst_projection: false, cfl: 0.3'
 exec "$sph" study scenes/swinging_cube.yaml \
-  --vary "method={$jst, fields: pF},{$jst, fields: pFJ},{$jst, fields: pFHJ},{name: tl-csph, cfl: 0.3}" \
+  --vary "method={fields: pF, $jst},{fields: pFJ, $jst},{fields: pFHJ, $jst},{name: tl-csph, cfl: 0.3}" \
   --vary bodies.0.particles.spacing=0.25,0.125,0.0625,0.041666666666666667 \
   --out outputs/swinging_cube_study "$@"
