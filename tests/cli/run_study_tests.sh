@@ -65,6 +65,28 @@ check "one case run" 'grep -q "4 cases (1 to run" "$work/stdout" && [ "$(grep -c
 check "only run 003 rewritten" '[ -n "$(find "$out/runs/003/summary.json" -newermt 2001-01-01)" ] && [ -z "$(find "$out"/runs/00[124]/summary.json -newermt 2001-01-01)" ]'
 check "4 rows again" '[ "$(wc -l <"$csv")" -eq 5 ] && grep -q "^pFJ,0.25," "$csv"'
 
+# --- a study killed (SIGKILL, the whole process group) after its first row
+# keeps that row; --resume runs only the others
+out3=$work/killed
+kill_args=(study "$scene" --set time.end=0.004 --threads 1 --vary
+  bodies.0.particles.spacing=0.25,0.0625,0.05 --out "$out3")
+setsid "$sph" "${kill_args[@]}" >"$work/kstdout" 2>&1 &
+pid=$!
+for _ in $(seq 600); do
+  [ "$(wc -l 2>/dev/null <"$out3/results.csv" || echo 0)" -ge 2 ] && break
+  sleep 0.05
+done
+kill -9 -- -"$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+rows=$(($(wc -l <"$out3/results.csv") - 1))
+echo "killed study: $rows row(s) kept"
+check "killed study kept $rows row(s), 1 or 2 expected" '[ "$rows" -ge 1 ] && [ "$rows" -le 2 ] && ! grep -q "^\[3/3\]" "$work/kstdout"'
+"$sph" "${kill_args[@]}" --resume >"$work/stdout" 2>"$work/stderr"
+rc=$?
+check "resume after kill exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'
+check "resume ran $((3 - rows)) case(s)" 'grep -q "3 cases ($((3 - rows)) to run" "$work/stdout" && [ "$(grep -c "^\[" "$work/stdout")" -eq $((3 - rows)) ]'
+check "3 rows after resume" '[ "$(wc -l <"$out3/results.csv")" -eq 4 ] && [ "$(cut -d, -f1 "$out3/results.csv" | tail -3 | sort -g | tr "\n" " ")" = "0.05 0.0625 0.25 " ]'
+
 # --- bracketed values; unstable runs stay rows
 out2=$work/brackets
 "$sph" study "$scene" "${short[@]}" --set 'bodies.0.particles={count: [3,3,3]}' \
