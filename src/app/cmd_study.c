@@ -26,13 +26,14 @@ typedef struct study_args {
   const char *resolution;
   const char *out;
   int resume;
+  int dry_run; /* validate and list the cases, run nothing */
 } study_args;
 
 static void usage_line(void) {
   fprintf(stderr,
           "usage: sph study SCENE --vary key=v1,v2,... [--vary ...] "
           "[--set k=v]... [--repeat N] [--threads N] [--resolution KEY] "
-          "[--out DIR] [--resume]\n");
+          "[--out DIR] [--resume] [--dry-run]\n");
 }
 
 /* Splits "key=v1,v2" on the commas outside brackets and quotes. */
@@ -139,6 +140,8 @@ static int parse_args(int argc, char **argv, study *s, study_args *a) {
       a->resolution = val;
     else if (!strcmp(o, "--resume"))
       a->resume = 1;
+    else if (!strcmp(o, "--dry-run"))
+      a->dry_run = 1;
     else if (o[0] == '-' && o[1] == '-') {
       fprintf(stderr, "sph study: unknown option %s\n", o);
       return SPH_EXIT_USAGE;
@@ -422,6 +425,17 @@ static int run_study(study *s, study_args *a) {
   int rc = validate(s, a, &checkpoint_off);
   if (rc != SPH_EXIT_OK)
     return rc;
+  if (a->dry_run) {
+    for (int i = 0; i < s->ncases; ++i) {
+      char label[2048];
+      case_label(s, &s->cases[i], label, sizeof label);
+      printf("[%d/%d] %s: %ld particles, dp = %.4g\n", i + 1, s->ncases, label,
+             s->cases[i].particles, s->cases[i].dp);
+    }
+    printf("sph study: %d case%s valid, nothing run (--dry-run)\n", s->ncases,
+           s->ncases == 1 ? "" : "s");
+    return SPH_EXIT_OK;
+  }
   if (a->out)
     snprintf(s->dir, sizeof s->dir, "%s", a->out);
   else

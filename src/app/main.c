@@ -27,7 +27,7 @@ static void usage(FILE *out) {
           "  study SCENE --vary k=v1,v2,... [--vary ...] [--set k=v]... "
           "[--repeat N]\n"
           "        [--threads N] [--resolution KEY] [--out DIR] "
-          "[--resume]\n"
+          "[--resume] [--dry-run]\n"
           "                       run every combination, write "
           "results.csv, report.md\n"
           "                       and plots (default outputs/<scene>_study)\n"

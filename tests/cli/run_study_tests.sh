@@ -117,5 +117,21 @@ check "no --vary: usage" '[ $rc -eq 2 ] && grep -q "usage: sph study" "$work/std
 rc=$?
 check "--resolution not varied" '[ $rc -eq 2 ] && grep -q "method.cfl" "$work/stderr"'
 
+"$sph" study "$scene" --vary method.fields=pF --repeat 0 --out "$work/bad_e" >/dev/null 2>"$work/stderr"
+rc=$?
+check "--repeat 0 refused" '[ $rc -eq 2 ] && grep -q "repeat" "$work/stderr" && [ ! -e "$work/bad_e" ]'
+
+# --- --repeat: one row, wall time the median of the repeats
+"$sph" study "$scene" "${short[@]}" --vary bodies.0.particles.spacing=0.25 --repeat 3 --out "$work/rep" >"$work/stdout" 2>&1
+rc=$?
+check "--repeat 3 (exit $rc)" '[ $rc -eq 0 ] && [ "$(wc -l <"$work/rep/results.csv")" -eq 2 ] && grep -q "median of 3 repeats" "$work/rep/report.md"'
+
+# --- the shipped studies are valid (--dry-run: validated, listed, not run)
+for f in "$src"/studies/*.sh; do
+  SPH=$sph "$f" --dry-run --out "$work/dry" >"$work/stdout" 2>"$work/stderr"
+  rc=$?
+  check "$(basename "$f") --dry-run (exit $rc): $(cat "$work/stderr")" '[ $rc -eq 0 ] && grep -q "valid, nothing run" "$work/stdout" && [ ! -e "$work/dry" ]'
+done
+
 echo "study tests: $pass passed, $fail failed"
 [ $fail -eq 0 ]
