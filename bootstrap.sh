@@ -15,6 +15,7 @@ packages=(
   libfreetype-dev fonts-dejavu-core  # text on frames
   python3-vtk9      # VTK's own reader validates the files we write (tests)
   clang-format      # formatting is a test
+  gnuplot-nox       # sph study figures (pngcairo)
 )
 for arg in "$@"; do
   case "$arg" in

@@ -47,6 +47,8 @@ int sph_app_load(const sph_app_args *args, const char *path,
 int sph_cmd_run(int argc, char **argv);
 int sph_cmd_check(int argc, char **argv);
 int sph_cmd_list(int argc, char **argv);
+/* sph study SCENE --vary k=a,b...: 0 done, 1 failed, 2 bad input */
+int sph_cmd_study(int argc, char **argv);
 /* sph imgdiff A.png B.png [options]: 0 passed, 1 different, 2 bad input */
 int sph_cmd_imgdiff(int argc, char **argv);
 

@@ -11,25 +11,33 @@
 #include "sph/sim.h"
 
 static void usage(FILE *out) {
-  fprintf(out, "usage: sph <command> [options]\n"
-               "\n"
-               "commands:\n"
-               "  run [SCENE] [--set k=v]... [--out DIR] [--threads N] "
-               "[--overwrite] [--quiet]\n"
-               "      [--resume DIR]   continue a killed run from its newest "
-               "checkpoint\n"
-               "                       simulate a scene (default: the twisting "
-               "column)\n"
-               "  check SCENE [--set k=v]...\n"
-               "                       validate a scene and print what will be "
-               "simulated\n"
-               "  list                 list the shipped scenes\n"
-               "  imgdiff A.png B.png [--tolerance N] [--shift N] "
-               "[--max-fraction F]\n"
-               "          [--max-cluster N] [--diff OUT.png]\n"
-               "                       compare two images (exit 0 same, 1 "
-               "different)\n"
-               "  help                 this text\n");
+  fprintf(out,
+          "usage: sph <command> [options]\n"
+          "\n"
+          "commands:\n"
+          "  run [SCENE] [--set k=v]... [--out DIR] [--threads N] "
+          "[--overwrite] [--quiet]\n"
+          "      [--resume DIR]   continue a killed run from its newest "
+          "checkpoint\n"
+          "                       simulate a scene (default: the twisting "
+          "column)\n"
+          "  check SCENE [--set k=v]...\n"
+          "                       validate a scene and print what will be "
+          "simulated\n"
+          "  study SCENE --vary k=v1,v2,... [--vary ...] [--set k=v]... "
+          "[--repeat N]\n"
+          "        [--threads N] [--resolution KEY] [--out DIR] "
+          "[--resume] [--dry-run]\n"
+          "                       run every combination, write "
+          "results.csv, report.md\n"
+          "                       and plots (default outputs/<scene>_study)\n"
+          "  list                 list the shipped scenes\n"
+          "  imgdiff A.png B.png [--tolerance N] [--shift N] "
+          "[--max-fraction F]\n"
+          "          [--max-cluster N] [--diff OUT.png]\n"
+          "                       compare two images (exit 0 same, 1 "
+          "different)\n"
+          "  help                 this text\n");
 }
 
 const char *sph_app_scenes_dir(void) {
@@ -135,6 +143,8 @@ int main(int argc, char **argv) {
     return sph_cmd_check(argc, argv);
   if (!strcmp(cmd, "list"))
     return sph_cmd_list(argc, argv);
+  if (!strcmp(cmd, "study"))
+    return sph_cmd_study(argc, argv);
   if (!strcmp(cmd, "imgdiff"))
     return sph_cmd_imgdiff(argc, argv);
   if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {

@@ -701,7 +701,17 @@ static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
 }
 
 static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
-  sph_node *png;
+  sph_node *png = sph_node_child(out, "png");
+  /* png: false turns the frames off (sph study, --set output.png=false) */
+  if (png && png->kind == SPH_NODE_SCALAR && !png->quoted) {
+    int on;
+    SPH_TRY(sph_node_as_bool(png, &on, err));
+    png->used = 1;
+    if (!on)
+      return SPH_OK;
+    return sph_node_error(png, err, SPH_ERR_TYPE,
+                          "expected a mapping or false");
+  }
   SPH_TRY(sph_node_get_map(out, "png", 0, &png, err));
   sph_png_output *p = &s->output.png;
   if (!png)

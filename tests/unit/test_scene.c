@@ -153,6 +153,24 @@ START_TEST(overrides) {
 }
 END_TEST
 
+/* output.png: a block turns frames on, false keeps them off */
+START_TEST(png_off) {
+  sph_scene *s;
+  sph_error err;
+  const char *on[] = {"output.png={}"};
+  ck_assert_int_eq(load_text(good, &s, on, 1, &err), SPH_OK);
+  ck_assert_int_eq(s->output.png.enabled, 1);
+  sph_scene_destroy(s);
+  const char *off[] = {"output.png={}", "output.png=false"};
+  ck_assert_int_eq(load_text(good, &s, off, 2, &err), SPH_OK);
+  ck_assert_int_eq(s->output.png.enabled, 0);
+  sph_scene_destroy(s);
+  const char *bad[] = {"output.png=true"};
+  ck_assert_int_eq(load_text(good, &s, bad, 1, &err), SPH_ERR_TYPE);
+  ck_assert_str_eq(err.key, "output.png");
+}
+END_TEST
+
 START_TEST(error_classes) {
   expect_error(with_line(14, "time: {end: 0.3, ned: 1}"), SPH_ERR_UNKNOWN_KEY,
                14, "ned", "time.ned", "did you mean 'end'");
@@ -220,6 +238,7 @@ int main(void) {
   TCase *tc = tcase_create("scene");
   tcase_add_test(tc, twisting_column_loads);
   tcase_add_test(tc, overrides);
+  tcase_add_test(tc, png_off);
   tcase_add_test(tc, error_classes);
   tcase_add_test(tc, dimension_and_shape_errors);
   suite_add_tcase(s, tc);

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# B1 swinging cube (scenes/swinging_cube.yaml, analytic reference): L2 errors
+# and convergence orders of tl-jst {p,F}, {p,F,J}, {p,F,H,J} and tl-csph at
+# four particle spacings (64 to 13824 particles). Extra options pass through,
+# e.g. ./studies/swinging_cube.sh --threads 2 --repeat 3, or --resume.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+sph=${SPH:-./build/sph}
+jst='name: tl-jst, jst: {eps2_p: 0, eps4_p: 0.125}, angular_momentum_projection: false, jst_projection: false, cfl: 0.3'
+exec "$sph" study scenes/swinging_cube.yaml \
+  --vary "method={fields: pF, $jst},{fields: pFJ, $jst},{fields: pFHJ, $jst},{name: tl-csph, cfl: 0.3}" \
+  --vary bodies.0.particles.spacing=0.25,0.125,0.0625,0.041666666666666667 \
+  --out outputs/swinging_cube_study "$@"
