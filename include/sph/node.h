@@ -72,6 +72,12 @@ sph_status sph_node_get_bool(sph_node *map, const char *key, int required,
 sph_status sph_node_get_string(sph_node *map, const char *key, int required,
                                const char *def, const char **out,
                                sph_error *err);
+/* A string that must be one of the NULL-terminated `values` (default
+ * `def`); *out receives its index. Other strings are errors at the value
+ * listing the allowed ones. */
+sph_status sph_node_get_choice(sph_node *map, const char *key,
+                               const char *const *values, const char *def,
+                               int *out, sph_error *err);
 /* A sequence of exactly n numbers; with n = 0 any length up to *got on
  * entry (the capacity of out). *got (if not NULL) receives the count; an
  * absent optional key gives count 0. */

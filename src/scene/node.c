@@ -670,6 +670,24 @@ sph_status sph_node_get_string(sph_node *map, const char *key, int required,
   return SPH_OK;
 }
 
+sph_status sph_node_get_choice(sph_node *map, const char *key,
+                               const char *const *values, const char *def,
+                               int *out, sph_error *err) {
+  const char *v;
+  SPH_TRY(sph_node_get_string(map, key, 0, def, &v, err));
+  char list[128] = "";
+  for (int i = 0; values[i]; ++i) {
+    if (!strcmp(values[i], v)) {
+      *out = i;
+      return SPH_OK;
+    }
+    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+    strncat(list, values[i], sizeof list - strlen(list) - 1);
+  }
+  return sph_node_error(sph_node_child(map, key), err, SPH_ERR_RANGE,
+                        "'%s' is not one of: %s", v, list);
+}
+
 sph_status sph_node_get_doubles(sph_node *map, const char *key, int required,
                                 size_t n, double *out, size_t *got,
                                 sph_error *err) {

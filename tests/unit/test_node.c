@@ -441,6 +441,30 @@ START_TEST(typed_getters) {
 }
 END_TEST
 
+/* one of a list: index, default inserted, other strings name the list */
+START_TEST(choices) {
+  sph_node *root = load("shear: laplacian\nbad: laplace\n");
+  static const char *const values[] = {"original", "laplacian", NULL};
+  sph_error err;
+  int k = -1;
+  ck_assert_int_eq(
+      sph_node_get_choice(root, "shear", values, "original", &k, &err), SPH_OK);
+  ck_assert_int_eq(k, 1);
+  ck_assert_int_eq(
+      sph_node_get_choice(root, "absent", values, "original", &k, &err),
+      SPH_OK);
+  ck_assert_int_eq(k, 0);
+  ck_assert_ptr_nonnull(sph_node_child(root, "absent"));
+  ck_assert_int_eq(
+      sph_node_get_choice(root, "bad", values, "original", &k, &err),
+      SPH_ERR_RANGE);
+  ck_assert_str_eq(err.key, "bad");
+  ck_assert_int_eq(err.line, 2);
+  ck_assert_str_eq(err.message, "'laplace' is not one of: original, laplacian");
+  sph_node_destroy(root);
+}
+END_TEST
+
 START_TEST(defaults_are_inserted_and_written) {
   sph_node *root = load("kernel: {type: cubic}\n");
   sph_node *k = sph_node_child(root, "kernel");
@@ -701,6 +725,7 @@ int main(void) {
   tcase_add_test(tc, unknown_key_suggests);
   tcase_add_test(tc, scalar_conversions);
   tcase_add_test(tc, typed_getters);
+  tcase_add_test(tc, choices);
   tcase_add_test(tc, defaults_are_inserted_and_written);
   tcase_add_test(tc, set_overrides);
   tcase_add_test(tc, write_load_round_trip);

@@ -202,24 +202,6 @@ static void tl_jst_destroy(sph_sim *sim) {
 /* ---- setup
  * -------------------------------------------------------------------------- */
 
-static sph_status parse_choice(sph_node *opt, const char *key,
-                               const char *const *values, const char *def,
-                               int *out, sph_error *err) {
-  const char *v;
-  SPH_TRY(sph_node_get_string(opt, key, 0, def, &v, err));
-  char list[128] = "";
-  for (int i = 0; values[i]; ++i) {
-    if (!strcmp(values[i], v)) {
-      *out = i;
-      return SPH_OK;
-    }
-    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-    strncat(list, values[i], sizeof list - strlen(list) - 1);
-  }
-  return sph_node_error(sph_node_child(opt, key), err, SPH_ERR_RANGE,
-                        "'%s' is not one of: %s", v, list);
-}
-
 static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
   *p = calloc(count ? count : 1, sizeof **p);
   return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "tl-jst arrays");
@@ -257,11 +239,12 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   static const char *const integrators[] = {"tvd-rk2", NULL};
   static const char *const bcs[] = {"direct", "lagrange", NULL};
   int f, fo, lp, integ, bc, amp, jproj;
-  SPH_TRY(parse_choice(opt, "fields", fields, "pF", &f, err));
-  SPH_TRY(parse_choice(opt, "force", forces, "conservative", &fo, err));
-  SPH_TRY(parse_choice(opt, "laplacian", laps, "corrected", &lp, err));
-  SPH_TRY(parse_choice(opt, "integrator", integrators, "tvd-rk2", &integ, err));
-  SPH_TRY(parse_choice(opt, "essential_bc", bcs, "direct", &bc, err));
+  SPH_TRY(sph_node_get_choice(opt, "fields", fields, "pF", &f, err));
+  SPH_TRY(sph_node_get_choice(opt, "force", forces, "conservative", &fo, err));
+  SPH_TRY(sph_node_get_choice(opt, "laplacian", laps, "corrected", &lp, err));
+  SPH_TRY(sph_node_get_choice(opt, "integrator", integrators, "tvd-rk2", &integ,
+                              err));
+  SPH_TRY(sph_node_get_choice(opt, "essential_bc", bcs, "direct", &bc, err));
   int lagrange_momentum;
   SPH_TRY(sph_node_get_bool(opt, "lagrange_momentum", 0, 0, &lagrange_momentum,
                             err));
@@ -271,7 +254,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "lagrange_momentum needs essential_bc: lagrange");
   static const char *const speeds[] = {"current", "reference", NULL};
   int ws;
-  SPH_TRY(parse_choice(opt, "wave_speed", speeds, "current", &ws, err));
+  SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "current", &ws, err));
   m->current_wave_speed = ws == 0;
   m->fields = (tl_jst_fields)f;
   m->force = (tl_jst_force)fo;

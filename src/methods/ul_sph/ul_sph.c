@@ -442,24 +442,6 @@ static void ul_sph_destroy(sph_sim *sim) {
 
 /* ---- setup -------------------------------------------------------------- */
 
-static sph_status parse_choice(sph_node *opt, const char *key,
-                               const char *const *values, const char *def,
-                               int *out, sph_error *err) {
-  const char *v;
-  SPH_TRY(sph_node_get_string(opt, key, 0, def, &v, err));
-  char list[128] = "";
-  for (int i = 0; values[i]; ++i) {
-    if (!strcmp(values[i], v)) {
-      *out = i;
-      return SPH_OK;
-    }
-    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-    strncat(list, values[i], sizeof list - strlen(list) - 1);
-  }
-  return sph_node_error(sph_node_child(opt, key), err, SPH_ERR_RANGE,
-                        "'%s' is not one of: %s", v, list);
-}
-
 static sph_status alloc(double **p, size_t count, sph_error *err) {
   *p = calloc(count ? count : 1, sizeof **p);
   return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "ul-sph state");
@@ -523,12 +505,13 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   static const char *const stepping[] = {"dual", "single", NULL};
   static const char *const cont[] = {"average", "riemann", NULL};
   int sh, ts, ct;
-  SPH_TRY(parse_choice(opt, "shear", shears, "laplacian", &sh, err));
+  SPH_TRY(sph_node_get_choice(opt, "shear", shears, "laplacian", &sh, err));
   /* OG and OAS as the paper ran them: single-criterion (with dual steps
    * OAS blows up on the rings within 1.5 ms) */
-  SPH_TRY(parse_choice(opt, "time_stepping", stepping,
-                       sh == UL_SHEAR_LAPLACIAN ? "dual" : "single", &ts, err));
-  SPH_TRY(parse_choice(opt, "continuity", cont, "average", &ct, err));
+  SPH_TRY(sph_node_get_choice(opt, "time_stepping", stepping,
+                              sh == UL_SHEAR_LAPLACIAN ? "dual" : "single", &ts,
+                              err));
+  SPH_TRY(sph_node_get_choice(opt, "continuity", cont, "average", &ct, err));
   m->shear = (ul_shear)sh;
   m->dual = ts == 0;
   m->pressure_term = ct == 1;
