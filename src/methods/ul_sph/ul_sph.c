@@ -113,13 +113,6 @@ static sph_status configuration_update(ul_sph *m, double t, sph_error *err) {
 
 /* ---- the two halves of an acoustic step ------------------------------ */
 
-static double max_wave_speed(const ul_sph *m) {
-  double c = 0.0;
-  for (size_t a = 0; a < m->n; ++a)
-    c = m->c0[a] > c ? m->c0[a] : c;
-  return c;
-}
-
 /* total stress of the artificial stress: R = -eps sigma'/rho^2 on the
  * positive principal stresses, rotated back */
 static void artificial_stress(ul_sph *m) {
@@ -274,7 +267,7 @@ static void continuity_and_shear(ul_sph *m, double dt) {
 static double ul_sph_stable_dt(sph_sim *sim) {
   ul_sph *m = sim->method_data;
   /* eq. 26 */
-  double dt = m->cfl_ac * sim->kernel.h / (max_wave_speed(m) + max_speed(m));
+  double dt = m->cfl_ac * sim->kernel.h / (m->c0_max + max_speed(m));
   /* the rest of the advection step in equal acoustic steps */
   double rest = m->config[0] - sim->t;
   if (m->dual && rest > 0.0 && rest < INFINITY)
@@ -600,6 +593,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     /* eq. 5: c0 = sqrt(E / (3 (1 - 2 nu) rho0)) = sqrt(kappa / rho0) */
     c0[a] = sqrt(mat->kappa / mat->density);
     G[a] = mat->mu;
+    m->c0_max = c0[a] > m->c0_max ? c0[a] : m->c0_max;
     m->rho[a] = rho0[a];
     m->m[a] = rho0[a] * V0[a];
     ps->field[SPH_FIELD_MASS][a] = m->m[a];
