@@ -8,7 +8,8 @@
  *   u64 particles  char method[32]  char scene[64]  u32 scene_crc
  *   f64 t  u64 steps  f64 dt_min dt_max dt_last  i32 next_output
  *   the verdict (its scalars)  u32 narrays
- *   narrays x (char name[16], u64 length)
+ *   narrays x (char name[16], u64 length): the method's state arrays,
+ *     then the scene reference's measurement ("reference") if it keeps one
  *   the arrays' f64 data
  *   u32 crc32 of everything before it (zlib)
  * A file is accepted only when every field matches the simulation it is

@@ -4,21 +4,36 @@
  * is the dilatational mode of the unit cube of seed 000 sec. 8.2 eq. 52,
  * u_i = U0 cos(w t) A_i f_i(X), w = sqrt(3)/2 c_d pi, with
  * f = (sin cos cos, cos sin cos, cos cos sin) of (pi X / 2) and the small
- * strain stress of the body's material. The initial state is F = I + grad u
- * and p = 0 (seed 000 sec. 8.2). Errors are L2 norms over the particles
- * (volume weighted), normalised by the amplitude of the exact field:
- * e_v by U0 w max|A_i|, e_P by the largest |P| at t = 0, e_u by U0. */
+ * strain stress of the body's material. The initial state is F = I + grad u,
+ * x = X + u and p = 0 (seed 000 sec. 8.2): methods that carry F as a
+ * variable take F, those that derive it from the positions take x; methods
+ * that cannot start deformed refuse the reference. Errors are L2 norms over the
+ * particles (volume weighted), normalised by the amplitude of the exact field:
+ * e_v by U0 w max|A_i|, e_P by the largest |P| at t = 0, e_u by U0.
+ *
+ *   reference: {period: {at: [0.2, 0], component: y}, value: 0.254,
+ *               tolerance: 0.05}
+ * is a scalar reference: the period of the displacement component of the
+ * particle nearest to `at` in the reference configuration, measured from the
+ * zero crossings of that displacement at the output frames (linear
+ * interpolation; near a crossing a sinusoid is linear to third order), as
+ * the mean over the half periods between the first and the last crossing:
+ * T = 2 (t_last - t_first) / (crossings - 1). Its error is |T - value| /
+ * value; `tolerance` (optional) is reported with it. */
 #ifndef SPH_REFERENCE_H
 #define SPH_REFERENCE_H
 
 #include "sph/scene.h"
 #include "sph/sim.h"
+#include "sph/sink.h"
 #include "sph/status.h"
 
 typedef struct sph_reference sph_reference;
 
+/* NaN where the reference does not give the quantity */
 typedef struct sph_reference_error {
   double l2_velocity, l2_stress, l2_displacement;
+  double period, period_value, period_error, period_tolerance;
 } sph_reference_error;
 
 /* NULL (and SPH_OK) when the scene has no reference block. */
@@ -26,13 +41,20 @@ sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
                                 sph_error *err);
 void sph_reference_destroy(sph_reference *r);
 
-/* Fills the particles' VELOCITY and DEFGRAD with the state at t = 0 and
- * marks sim->initial_defgrad. */
+/* Fills the particles' POSITION, VELOCITY and DEFGRAD with the state at
+ * t = 0 and marks sim->initial_defgrad. */
 sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
                                     sph_error *err);
 
+/* Takes an output frame (after method->derive) into the measurement. */
+void sph_reference_observe(sph_reference *r, const sph_frame *frame);
+
+/* The measurement's state for checkpoints: fills arr and returns 1, or 0
+ * when the reference keeps none (r may be NULL). */
+int sph_reference_state(sph_reference *r, sph_state_array *arr);
+
 /* Errors of the derived fields (velocity, first Piola-Kirchhoff stress,
- * displacement since t = 0) at the sim's time. */
+ * displacement x - X) at the sim's time. */
 void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
                           sph_reference_error *e);
 

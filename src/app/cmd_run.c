@@ -14,6 +14,7 @@
 #include "app/app_impl.h"
 #include "app/progress_impl.h"
 #include "sph/checkpoint.h"
+#include "sph/reference.h"
 #include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
@@ -150,6 +151,8 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
   }
   if (st == SPH_OK)
     st = sph_verdict_observe(v, &fr, err);
+  if (st == SPH_OK && sim->reference)
+    sph_reference_observe(sim->reference, &fr);
   return st;
 }
 

@@ -283,6 +283,7 @@ static int read_summary(const char *path, study_row *r) {
   const sph_node *e = sph_node_child(root, "error");
   for (int k = 0; k < STUDY_NORMS; ++k)
     r->l2[k] = number(e, study_norm_names[k]);
+  r->period = number(e, "period");
   const sph_node *en = sph_node_child(root, "energy");
   double e0 = number(en, "initial"), e1 = number(en, "final");
   r->energy_drift = e0 != 0.0 ? (e1 - e0) / fabs(e0) : NAN;
@@ -355,6 +356,7 @@ static void run_case(const study *s, const study_args *a, const study_case *c,
     return;
   for (int j = 0; j < STUDY_NORMS; ++j)
     row->l2[j] = NAN;
+  row->period = NAN;
   row->energy_drift = row->lin_drift = row->ang_drift = NAN;
   row->particles = c->particles;
   if (WIFSIGNALED(status))

@@ -10,7 +10,7 @@
 
 #define STUDY_MAX_KEYS 8
 #define STUDY_MAX_VALUES 64
-#define STUDY_NORMS 3
+#define STUDY_NORMS 4
 
 extern const char *const study_norm_names[STUDY_NORMS];
 
@@ -20,7 +20,8 @@ typedef struct study_row {
   double dp;
   unsigned long steps;
   double wall, rate;
-  double l2[STUDY_NORMS]; /* NAN when the scene has no reference */
+  double l2[STUDY_NORMS]; /* errors; NAN where the reference gives none */
+  double period;          /* a period reference's measured period, or NAN */
   double energy_drift, lin_drift, ang_drift;
   int stable;
   char reason[256];

@@ -13,8 +13,8 @@
 #include "app/study_impl.h"
 #include "sph/sink.h"
 
-const char *const study_norm_names[STUDY_NORMS] = {"l2_velocity", "l2_stress",
-                                                   "l2_displacement"};
+const char *const study_norm_names[STUDY_NORMS] = {
+    "l2_velocity", "l2_stress", "l2_displacement", "period_error"};
 
 static const char *const fixed_columns[] = {"particles",
                                             "dp",
@@ -24,13 +24,15 @@ static const char *const fixed_columns[] = {"particles",
                                             "l2_velocity",
                                             "l2_stress",
                                             "l2_displacement",
+                                            "period_error",
+                                            "period",
                                             "energy_drift",
                                             "linear_momentum_drift",
                                             "angular_momentum_drift",
                                             "stable",
                                             "reason",
                                             NULL};
-#define NFIXED 13
+#define NFIXED 15
 
 static void csv_field(FILE *f, const char *s) {
   if (!strpbrk(s, ",\"\n")) {
@@ -75,6 +77,7 @@ void study_csv_row(const study *s, const study_case *c, FILE *f) {
   csv_number(f, r->rate);
   for (int k = 0; k < STUDY_NORMS; ++k)
     csv_number(f, r->l2[k]);
+  csv_number(f, r->period);
   csv_number(f, r->energy_drift);
   csv_number(f, r->lin_drift);
   csv_number(f, r->ang_drift);
@@ -164,13 +167,15 @@ sph_status study_csv_read(study *s, const char *path, sph_error *err) {
       r->steps = (unsigned long)field_number(v[2]);
       r->wall = field_number(v[3]);
       r->rate = field_number(v[4]);
+      int j = 5;
       for (int k = 0; k < STUDY_NORMS; ++k)
-        r->l2[k] = field_number(v[5 + k]);
-      r->energy_drift = field_number(v[8]);
-      r->lin_drift = field_number(v[9]);
-      r->ang_drift = field_number(v[10]);
-      r->stable = !strcmp(v[11], "true");
-      snprintf(r->reason, sizeof r->reason, "%s", v[12]);
+        r->l2[k] = field_number(v[j++]);
+      r->period = field_number(v[j++]);
+      r->energy_drift = field_number(v[j++]);
+      r->lin_drift = field_number(v[j++]);
+      r->ang_drift = field_number(v[j++]);
+      r->stable = !strcmp(v[j++], "true");
+      snprintf(r->reason, sizeof r->reason, "%s", v[j]);
       c->done = 1;
       break;
     }
@@ -282,14 +287,28 @@ sph_status study_report_write(const study *s, sph_error *err) {
           "of %d repeat%s.\n\n",
           s->scene_name, s->scene_path, s->ncases, s->ncases == 1 ? "" : "s",
           s->repeat, s->repeat == 1 ? "" : "s");
+  /* the error columns some run reports, the period if measured */
+  int present[STUDY_NORMS], has_period = 0, ncols = s->nkeys + 10;
+  norms_present(s, present);
+  for (int i = 0; i < s->ncases; ++i)
+    has_period |= s->cases[i].done && isfinite(s->cases[i].row.period);
   fputs("|", f);
   for (int k = 0; k < s->nkeys; ++k)
     fprintf(f, " %s |", s->keys[k]);
-  fputs(" particles | dp | steps | wall s | particle-steps/s | l2_velocity | "
-        "l2_stress | l2_displacement | energy drift | lin. mom. drift | ang. "
-        "mom. drift | stable | reason |\n|",
+  fputs(" particles | dp | steps | wall s | particle-steps/s |", f);
+  for (int k = 0; k < STUDY_NORMS; ++k)
+    if (present[k]) {
+      fprintf(f, " %s |", study_norm_names[k]);
+      ++ncols;
+    }
+  if (has_period) {
+    fputs(" period |", f);
+    ++ncols;
+  }
+  fputs(" energy drift | lin. mom. drift | ang. mom. drift | stable | reason "
+        "|\n|",
         f);
-  for (int k = 0; k < s->nkeys + NFIXED; ++k)
+  for (int k = 0; k < ncols; ++k)
     fputs("---|", f);
   fputc('\n', f);
   for (int i = 0; i < s->ncases; ++i) {
@@ -306,14 +325,15 @@ sph_status study_report_write(const study *s, sph_error *err) {
     md_number(f, r->wall);
     md_number(f, r->rate);
     for (int k = 0; k < STUDY_NORMS; ++k)
-      md_number(f, r->l2[k]);
+      if (present[k])
+        md_number(f, r->l2[k]);
+    if (has_period)
+      md_number(f, r->period);
     md_number(f, r->energy_drift);
     md_number(f, r->lin_drift);
     md_number(f, r->ang_drift);
     fprintf(f, " %s | %s |\n", r->stable ? "yes" : "**no**", r->reason);
   }
-  int present[STUDY_NORMS];
-  norms_present(s, present);
   fprintf(f,
           "\n## Convergence\n\nA series is the runs that differ only in "
           "`%s` (the resolution axis). The order is the least-squares slope "
@@ -323,7 +343,10 @@ sph_status study_report_write(const study *s, sph_error *err) {
           "lattice, as `sph check` prints it). Energy drift is "
           "(final - initial) / |initial| total energy.\n\n",
           s->keys[s->resolution]);
-  if (!present[0] && !present[1] && !present[2])
+  int any = 0;
+  for (int k = 0; k < STUDY_NORMS; ++k)
+    any |= present[k];
+  if (!any)
     fputs("The scene has no `reference:` block: no error norms, no "
           "orders.\n",
           f);
@@ -436,7 +459,9 @@ static void gp_data(FILE *f, const study *s, const int *leads, int nlead, int k,
 static void gp_figure(FILE *f, const study *s, const int *leads, int nlead,
                       const int present[STUDY_NORMS], int xdp,
                       const char *png) {
-  int npanels = present[0] + present[1] + present[2];
+  int npanels = 0;
+  for (int k = 0; k < STUDY_NORMS; ++k)
+    npanels += present[k];
   fprintf(f,
           "set terminal pngcairo noenhanced size %d,600 font 'DejaVu Sans,10'\n"
           "set output ",
@@ -500,7 +525,10 @@ sph_status study_plots_write(const study *s, sph_error *err) {
   for (int k = 0; k < STUDY_NORMS; ++k)
     for (int j = 0; j < nlead; ++j)
       present[k] |= series_points(s, leads[j], k, 1) > 0;
-  if (!present[0] && !present[1] && !present[2])
+  int any = 0;
+  for (int k = 0; k < STUDY_NORMS; ++k)
+    any |= present[k];
+  if (!any)
     return sph_error_set(err, SPH_ERR_ARG,
                          "no stable run reports an error norm");
   char script[1100], png[2][1100], part[2][2300], log[1100];

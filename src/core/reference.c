@@ -1,5 +1,5 @@
-/* Analytic reference solutions (see include/sph/reference.h): the swinging
- * cube of seed 000 sec. 8.2 eq. 52. */
+/* Reference solutions (see include/sph/reference.h): the swinging cube of
+ * seed 000 sec. 8.2 eq. 52, and a measured period against a scalar value. */
 #include "sph/reference.h"
 
 #include <math.h>
@@ -8,7 +8,20 @@
 
 #include "sph/tensor.h"
 
+typedef enum { REF_SWINGING_CUBE, REF_PERIOD } ref_kind;
+
+/* the period observer's state, kept as doubles for checkpoints */
+enum { OBS_U, OBS_T, OBS_SIGN, OBS_CROSSINGS, OBS_FIRST, OBS_LAST, OBS_N };
+
 struct sph_reference {
+  ref_kind kind;
+  /* period: probe position, displacement component, reference value */
+  double at[3];
+  int component;
+  double value, tolerance;
+  size_t particle;
+  double obs[OBS_N];
+  /* swinging cube */
   double U0, A[3];
   double omega;        /* sqrt(3)/2 c_d pi */
   double lambda, mu;   /* small strain moduli of the body */
@@ -46,12 +59,35 @@ static void stress(const sph_reference *r, const double G[9], double P[9]) {
           r->mu * (G[3 * i + j] + G[3 * j + i]) + (i == j) * r->lambda * tr;
 }
 
-sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
-                                sph_error *err) {
-  *out = NULL;
-  sph_node *n = s->reference;
-  if (!n)
-    return SPH_OK;
+/* reference: {period: {at: [x, y, (z)], component: x|y|z}, value: T,
+ *             tolerance: tol} */
+static sph_status period_create(sph_reference *r, const sph_scene *s,
+                                sph_node *n, sph_error *err) {
+  static const char *const keys[] = {"period", "value", "tolerance", NULL};
+  static const char *const pkeys[] = {"at", "component", NULL};
+  static const char *const axes[] = {"x", "y", "z", NULL};
+  SPH_TRY(sph_node_check_keys(n, keys, err));
+  sph_node *p;
+  SPH_TRY(sph_node_get_map(n, "period", 1, &p, err));
+  SPH_TRY(sph_node_check_keys(p, pkeys, err));
+  SPH_TRY(
+      sph_node_get_doubles(p, "at", 1, (size_t)s->dimension, r->at, NULL, err));
+  SPH_TRY(sph_node_get_choice(p, "component", axes, "y", &r->component, err));
+  if (r->component >= s->dimension)
+    return sph_node_error(sph_node_child(p, "component"), err, SPH_ERR_RANGE,
+                          "component %s of a %dD scene", axes[r->component],
+                          s->dimension);
+  SPH_TRY(sph_node_get_double(n, "value", 1, 0.0, &r->value, err));
+  SPH_TRY(sph_node_get_double(n, "tolerance", 0, NAN, &r->tolerance, err));
+  if (!(r->value > 0.0))
+    return sph_node_error(sph_node_child(n, "value"), err, SPH_ERR_RANGE,
+                          "a period must be positive");
+  r->kind = REF_PERIOD;
+  return SPH_OK;
+}
+
+static sph_status swinging_cube_create(sph_reference *r, const sph_scene *s,
+                                       sph_node *n, sph_error *err) {
   static const char *const keys[] = {"analytic", "U0", "A", "B", "C", NULL};
   SPH_TRY(sph_node_check_keys(n, keys, err));
   const char *kind;
@@ -63,23 +99,36 @@ sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
   if (s->dimension != 3 || s->nbodies != 1)
     return sph_node_error(n, err, SPH_ERR_ARG,
                           "swinging_cube needs one body in 3D");
-  sph_reference *r = calloc(1, sizeof *r);
-  if (!r)
-    return sph_error_set(err, SPH_ERR_NOMEM, "reference");
-  sph_status st = sph_node_get_double(n, "U0", 0, 5e-4, &r->U0, err);
+  SPH_TRY(sph_node_get_double(n, "U0", 0, 5e-4, &r->U0, err));
   static const char *const amp[] = {"A", "B", "C"};
-  for (int i = 0; i < 3 && st == SPH_OK; ++i)
-    st = sph_node_get_double(n, amp[i], 0, 1.0, &r->A[i], err);
-  if (st != SPH_OK) {
-    free(r);
-    return st;
-  }
+  for (int i = 0; i < 3; ++i)
+    SPH_TRY(sph_node_get_double(n, amp[i], 0, 1.0, &r->A[i], err));
   const sph_material *m = &s->materials[s->bodies[0].material];
   r->lambda = m->lambda;
   r->mu = m->mu;
   r->omega = sqrt(3.0) / 2.0 * sph_material_wave_speed(m) * M_PI;
   r->v_amp = r->U0 * r->omega *
              fmax(fabs(r->A[0]), fmax(fabs(r->A[1]), fabs(r->A[2])));
+  r->kind = REF_SWINGING_CUBE;
+  return SPH_OK;
+}
+
+sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
+                                sph_error *err) {
+  *out = NULL;
+  sph_node *n = s->reference;
+  if (!n)
+    return SPH_OK;
+  sph_reference *r = calloc(1, sizeof *r);
+  if (!r)
+    return sph_error_set(err, SPH_ERR_NOMEM, "reference");
+  sph_status st = sph_node_child(n, "period")
+                      ? period_create(r, s, n, err)
+                      : swinging_cube_create(r, s, n, err);
+  if (st != SPH_OK) {
+    free(r);
+    return st;
+  }
   *out = r;
   return SPH_OK;
 }
@@ -89,17 +138,37 @@ void sph_reference_destroy(sph_reference *r) { free(r); }
 sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
                                     sph_error *err) {
   sph_particles *ps = sim->ps;
-  SPH_TRY(sph_particles_require(ps, SPH_FIELD_DEFGRAD, err));
   sph_reference *rw = (sph_reference *)r; /* amplitude found on the set */
+  if (r->kind == REF_PERIOD) {
+    /* the particle nearest to `at` in the reference configuration */
+    double best = INFINITY;
+    for (size_t a = 0; a < ps->n; ++a) {
+      const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+      double d = 0.0;
+      for (int c = 0; c < 3; ++c)
+        d += (X[c] - r->at[c]) * (X[c] - r->at[c]);
+      if (d < best) {
+        best = d;
+        rw->particle = a;
+      }
+    }
+    memset(rw->obs, 0, sizeof rw->obs);
+    return SPH_OK;
+  }
+  SPH_TRY(sph_particles_require(ps, SPH_FIELD_DEFGRAD, err));
+  SPH_TRY(sph_particles_require(ps, SPH_FIELD_POSITION, err));
   rw->P_amp = 0.0;
   for (size_t a = 0; a < ps->n; ++a) {
     double f[3], G[9], P[9];
     mode(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, f, G);
+    const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
     double *F = ps->field[SPH_FIELD_DEFGRAD] + 9 * a;
     for (int k = 0; k < 9; ++k)
       F[k] = (k % 4 == 0) + r->U0 * G[k];
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < 3; ++c) {
+      ps->field[SPH_FIELD_POSITION][3 * a + c] = X[c] + r->U0 * f[c];
       ps->field[SPH_FIELD_VELOCITY][3 * a + c] = 0.0;
+    }
     for (int k = 0; k < 9; ++k)
       G[k] *= r->U0;
     stress(r, G, P);
@@ -109,8 +178,51 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
   return SPH_OK;
 }
 
+void sph_reference_observe(sph_reference *r, const sph_frame *fr) {
+  if (r->kind != REF_PERIOD)
+    return;
+  const sph_particles *ps = fr->ps;
+  int c = r->component;
+  double u = ps->field[SPH_FIELD_POSITION][3 * r->particle + c] -
+             ps->field[SPH_FIELD_POSITION0][3 * r->particle + c];
+  double *o = r->obs, sign = u > 0.0 ? 1.0 : u < 0.0 ? -1.0 : 0.0;
+  /* a zero crossing between the previous sample and this one */
+  if (sign != 0.0 && o[OBS_SIGN] != 0.0 && sign != o[OBS_SIGN]) {
+    double tc = o[OBS_T] + (fr->time - o[OBS_T]) * o[OBS_U] / (o[OBS_U] - u);
+    if (o[OBS_CROSSINGS] == 0.0)
+      o[OBS_FIRST] = tc;
+    o[OBS_LAST] = tc;
+    o[OBS_CROSSINGS] += 1.0;
+  }
+  if (sign != 0.0)
+    o[OBS_SIGN] = sign;
+  o[OBS_U] = u;
+  o[OBS_T] = fr->time;
+}
+
+int sph_reference_state(sph_reference *r, sph_state_array *arr) {
+  if (!r || r->kind != REF_PERIOD)
+    return 0;
+  *arr = (sph_state_array){.name = "reference", .data = r->obs, .len = OBS_N};
+  return 1;
+}
+
 void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
                           sph_reference_error *e) {
+  e->l2_velocity = e->l2_stress = e->l2_displacement = NAN;
+  e->period = e->period_value = e->period_error = NAN;
+  e->period_tolerance = r->tolerance;
+  if (r->kind == REF_PERIOD) {
+    /* mean period over the half periods between the first and last
+     * crossings */
+    double n = r->obs[OBS_CROSSINGS];
+    e->period_value = r->value;
+    if (n >= 2.0) {
+      e->period = 2.0 * (r->obs[OBS_LAST] - r->obs[OBS_FIRST]) / (n - 1.0);
+      e->period_error = fabs(e->period - r->value) / r->value;
+    }
+    return;
+  }
   const sph_particles *ps = sim->ps;
   double t = sim->t, cw = cos(r->omega * t), sw = sin(r->omega * t);
   double sv = 0.0, ev = 0.0, eP = 0.0, eu = 0.0;
@@ -126,7 +238,7 @@ void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
     const double *Pn = ps->field[SPH_FIELD_PK1] + 9 * a;
     for (int i = 0; i < 3; ++i) {
       double vex = -r->U0 * r->omega * sw * f[i];
-      double uex = r->U0 * (cw - 1.0) * f[i]; /* x - X = u(t) - u(0) */
+      double uex = r->U0 * cw * f[i];
       ev += V * (v[i] - vex) * (v[i] - vex);
       eu += V * (u[i] - uex) * (u[i] - uex);
     }

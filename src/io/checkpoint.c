@@ -11,6 +11,7 @@
 
 #include "sph/checkpoint.h"
 #include "sph/node.h"
+#include "sph/reference.h"
 #include "sph/sink.h"
 
 static const char magic[8] = "SPHCKPT";
@@ -133,8 +134,9 @@ sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
                                 sph_error *err) {
   unsigned crc = 0;
   SPH_TRY(sph_checkpoint_scene_crc(sim->scene, &crc, err));
-  sph_state_array arr[SPH_MAX_STATE];
+  sph_state_array arr[SPH_MAX_STATE + 1];
   int na = sim->method->state((sph_sim *)sim, arr);
+  na += sph_reference_state(sim->reference, arr + na);
   char path[1024], prev[1100];
   snprintf(path, sizeof path, "%s/%s", dir, SPH_CHECKPOINT_FILE);
   snprintf(prev, sizeof prev, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS);
@@ -266,8 +268,9 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
     if (!get(&r, (char *)&vv + verdict_fields[i].off, verdict_fields[i].size))
       FAIL("truncated verdict");
   vv.reason[sizeof vv.reason - 1] = '\0';
-  sph_state_array arr[SPH_MAX_STATE];
+  sph_state_array arr[SPH_MAX_STATE + 1];
   int nm = sim->method->state(sim, arr);
+  nm += sph_reference_state(sim->reference, arr + nm);
   if (!get(&r, &na, 4) || na != (uint32_t)nm)
     FAIL("holds %u state arrays, method %s has %d", na, h.method, nm);
   for (int i = 0; i < nm; ++i) {

@@ -120,12 +120,26 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   if (sim->reference) {
     sph_reference_error e;
     sph_reference_errors(sim->reference, sim, &e);
-    fputs(",\n  \"error\": {\"l2_velocity\": ", f);
-    json_number(f, e.l2_velocity);
-    fputs(", \"l2_stress\": ", f);
-    json_number(f, e.l2_stress);
-    fputs(", \"l2_displacement\": ", f);
-    json_number(f, e.l2_displacement);
+    /* the quantities this reference gives */
+    const struct {
+      const char *key;
+      double x;
+    } q[] = {{"l2_velocity", e.l2_velocity},
+             {"l2_stress", e.l2_stress},
+             {"l2_displacement", e.l2_displacement},
+             {"period", e.period},
+             {"period_reference", e.period_value},
+             {"period_error", e.period_error},
+             {"period_tolerance", e.period_tolerance}};
+    const char *sep = ",\n  \"error\": {";
+    size_t k0 = e.period_value > 0.0 ? 3 : 0, k1 = k0 ? 7 : 3;
+    for (size_t k = k0; k < k1; ++k) {
+      if (k == 6 && isnan(q[k].x)) /* no tolerance given */
+        continue;
+      fprintf(f, "%s\"%s\": ", sep, q[k].key);
+      json_number(f, q[k].x);
+      sep = ", ";
+    }
     fputs("}", f);
   }
   fprintf(f, ",\n  \"threads\": %d,\n  \"t_end\": ", sim->threads);

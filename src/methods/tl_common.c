@@ -286,8 +286,12 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
     ref->J = ps->field[SPH_FIELD_JACOBIAN];
     ref->P = ps->field[SPH_FIELD_PK1];
   }
+  /* a reference's initial state comes deformed (reference.h) */
+  const double *x0 =
+      sim->initial_defgrad ? ps->field[SPH_FIELD_POSITION] : ref->X;
   for (size_t a = 0; a < n; ++a) {
-    memcpy(ref->x + 3 * a, ref->X + 3 * a, 3 * sizeof(double));
+    if (ref->x != x0)
+      memcpy(ref->x + 3 * a, x0 + 3 * a, 3 * sizeof(double));
     for (int c = 0; c < 3; ++c)
       ref->p[3 * a + c] =
           ref->rho0[a] * ps->field[SPH_FIELD_VELOCITY][3 * a + c];

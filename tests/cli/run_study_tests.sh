@@ -3,7 +3,8 @@
 # results.csv rows and columns, report.md with fitted orders and the gnuplot
 # figures; bracketed values split only on top-level commas; unstable runs
 # stay rows; a bad --vary stops before anything is written (exit 2, key
-# named); --resume reruns only the case whose row was deleted.
+# named); --resume reruns only the case whose row was deleted; a period
+# reference fills the period columns.
 set -u
 sph=$1
 src=$2
@@ -30,8 +31,8 @@ rc=$?
 check "study exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'
 csv=$out/results.csv
 check "results.csv has a header and 4 rows" '[ "$(wc -l <"$csv")" -eq 5 ]'
-check "15 columns" '[ "$(ncols "$csv" 1)" -eq 15 ] && [ "$(ncols "$csv" 5)" -eq 15 ]'
-check "header" 'head -1 "$csv" | grep -q "^method.fields,bodies.0.particles.spacing,particles,dp,steps,wall_seconds,particle_steps_per_second,l2_velocity,l2_stress,l2_displacement,energy_drift,linear_momentum_drift,angular_momentum_drift,stable,reason$"'
+check "17 columns" '[ "$(ncols "$csv" 1)" -eq 17 ] && [ "$(ncols "$csv" 5)" -eq 17 ]'
+check "header" 'head -1 "$csv" | grep -q "^method.fields,bodies.0.particles.spacing,particles,dp,steps,wall_seconds,particle_steps_per_second,l2_velocity,l2_stress,l2_displacement,period_error,period,energy_drift,linear_momentum_drift,angular_momentum_drift,stable,reason$"'
 check "rows in case order" '[ "$(cut -d, -f1,2 "$csv" | tail -4 | tr "\n" " ")" = "pF,0.25 pF,0.125 pFJ,0.25 pFJ,0.125 " ]'
 check "particles 64 and 512" '[ "$(field "$csv" 0 particles)" = 64 ] && [ "$(field "$csv" 1 particles)" = 512 ]'
 check "l2_velocity filled" 'python3 -c "import sys; assert 0 < float(sys.argv[1]) < 1" "$(field "$csv" 1 l2_velocity)"'
@@ -120,6 +121,15 @@ check "--resolution not varied" '[ $rc -eq 2 ] && grep -q "method.cfl" "$work/st
 "$sph" study "$scene" --vary method.fields=pF --repeat 0 --out "$work/bad_e" >/dev/null 2>"$work/stderr"
 rc=$?
 check "--repeat 0 refused" '[ $rc -eq 2 ] && grep -q "repeat" "$work/stderr" && [ ! -e "$work/bad_e" ]'
+
+# --- a period reference: the 2D plate's first period at H/dp 5
+"$sph" study "$src/scenes/oscillating_plate_2d.yaml" --threads 1 \
+  --set time.end=0.3 --vary bodies.0.particles.spacing=0.004 \
+  --out "$work/per" >"$work/stdout" 2>"$work/stderr"
+rc=$?
+check "period study exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'
+check "period and its error filled" 'python3 -c "import sys; p, e = float(sys.argv[1]), float(sys.argv[2]); assert 0.2 < p < 0.35 and abs(e - abs(p - 0.254) / 0.254) < 1e-5" "$(field "$work/per/results.csv" 0 period)" "$(field "$work/per/results.csv" 0 period_error)"'
+check "report.md period column, no L2 columns" 'grep -q "| period_error | period |" "$work/per/report.md" && ! grep -q "l2_velocity" "$work/per/report.md"'
 
 # --- --repeat: one row, wall time the median of the repeats
 "$sph" study "$scene" "${short[@]}" --vary bodies.0.particles.spacing=0.25 --repeat 3 --out "$work/rep" >"$work/stdout" 2>&1

@@ -484,6 +484,11 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   const sph_scene *s = sim->scene;
   SPH_TRY(check_scene(s, err));
+  /* the stress is a rate-integrated state that starts at zero */
+  if (sim->initial_defgrad)
+    return sph_node_error(s->reference, err, SPH_ERR_ARG,
+                          "ul-sph cannot start from the deformed state of a "
+                          "`reference:` (its stress starts at zero)");
   ul_sph *m = calloc(1, sizeof *m);
   if (!m)
     return sph_error_set(err, SPH_ERR_NOMEM, "ul-sph");
