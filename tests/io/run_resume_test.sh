@@ -30,7 +30,7 @@ same_run() { # uninterrupted dir, resumed dir, scene name
     fail "probes.csv differs after resume"
   # summary numbers (not wall times)
   for key in steps dt_min dt_max energy J linear_momentum_drift angular_momentum_drift \
-    fracture zigzag_max stable; do
+    fracture zigzag_max stable error; do
     [ "$(grep "\"$key\"" "$a/summary.json")" = "$(grep "\"$key\"" "$b/summary.json")" ] ||
       fail "summary.json $key differs after resume"
   done
@@ -67,6 +67,12 @@ kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}'
 # checkpoint's positions of the last update
 kill_and_resume ul-sph colliding_rings 0.006 0.0005 \
   --set bodies.0.particles.spacing=0.002 --set bodies.1.particles.spacing=0.002
+# a period reference: its first crossing (t ~ 0.13) is in the checkpoint
+# of t = 0.2 the run resumes from
+kill_and_resume period oscillating_plate_2d 0.3 0.1 \
+  --set bodies.0.particles.spacing=0.004
+grep -q '"period": 0\.2' "$work/period-b/summary.json" ||
+  fail "period: no period measured after resume"
 
 # damaged and mismatched checkpoints are refused, nothing is changed
 d=$work/tl-jst-b
