@@ -21,9 +21,21 @@
  * looks at the camera.
  * `ghost` paints the reference configuration as a grey outlined silhouette
  * under the current state. sph_png_check validates all of this before a run.
- * Created only when the scene has a `png` block. */
+ * Created only when the scene has a `png` block.
+ *
+ * Threading: `write` runs on the simulation thread only as long as it takes
+ * to copy the kept particles' positions and colour values into one of two
+ * snapshots allocated at `open` and to advance the range (in frame order,
+ * so the colours never depend on timing); a render thread owned by the sink
+ * makes the one OSMesa context current, draws, composites and writes the
+ * frame. One frame is in flight: `write` waits only while the frame before
+ * is still being rendered; `flush` and `close` wait for every frame handed
+ * over. The render thread's first error (naming the frame's file) is
+ * returned by the next write, flush or close. sph_png_sink_sync_ops
+ * (png_sink_impl.h) renders on the calling thread instead. */
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,27 +43,55 @@
 
 #include "gl_impl.h"
 #include "overlay_impl.h"
+#include "png_sink_impl.h"
 #include "sph/geometry.h"
 #include "sph/image.h"
 #include "sph/render.h"
 
+/* One frame as the simulation thread hands it to the renderer. */
+typedef struct png_frame {
+  float *xyz;    /* the kept particles' current positions, in index order */
+  double *value; /* their colour values (NaN: none) */
+  double lo, hi; /* colour range of this frame */
+  int clamped_low, clamped_high;
+  double time;
+  int index;
+} png_frame;
+
 typedef struct png_sink {
+  /* fixed at open; read by both threads */
+  sph_view view;
+  char dir[1024], name[128], title[96];
+  int width, height;
+  sph_colormap_kind map;
+  double dp;
+  size_t nkeep;                          /* particles drawn (cut) */
+  int clip, ghost;                       /* cutaway and outline flags */
+  double plane[4];                       /* clip: -n, at */
+  float *ghost_xyz;                      /* reference positions, kept ones */
+  unsigned char *ghost_rim, *ghost_fill; /* their colours */
+  /* simulation thread: field, range policy, the two snapshots */
+  unsigned char *keep; /* cut: the particles drawn */
+  int field, ncomp;
+  int have_range, symmetric, fixed;
+  double lo, hi;
+  png_frame slot[2];
+  int next; /* the slot the next write fills */
+  /* renderer: only the render thread (or, without one, the caller) */
   sph_gl *gl;
   sph_text *text;
   sph_image img;
-  sph_view view;
-  char dir[1024], name[128];
-  float *xyz;
   unsigned char *rgb;
-  double *value;
-  unsigned char *keep; /* cut: the particles drawn */
-  float *ghost_xyz;    /* reference positions of the kept particles */
-  unsigned char *ghost_rim, *ghost_fill; /* their colours */
-  size_t nkeep;
-  double plane[4]; /* clip: -n, at */
-  sph_colormap_kind map;
-  int have_range, symmetric, fixed;
-  double lo, hi;
+  /* hand-over between the threads, under mu */
+  int threaded, locks_made, started;
+  pthread_t thread;
+  pthread_mutex_t mu;
+  pthread_cond_t cv;
+  int ready, quit;   /* renderer created (or failed); thread to exit */
+  png_frame *queued; /* handed over and not yet written; NULL when idle */
+  sph_status status; /* first unreported renderer error, and its record */
+  sph_error error;
+  double busy; /* render thread wall seconds spent on frames */
 } png_sink;
 
 /* Scalar value of particle a: the field itself or its magnitude. */
@@ -260,144 +300,42 @@ static const unsigned char ghost_rim[3] = {168, 170, 178};
 #define GHOST_FILL 0.72
 #define GHOST_RIM 0.84
 
-static sph_status png_open(sph_sink *sink, const sph_sim *sim, const char *dir,
-                           sph_error *err) {
-  const sph_scene *s = sim->scene;
-  const sph_png_output *o = &s->output.png;
-  png_sink *p = calloc(1, sizeof *p);
-  if (!p)
-    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
-  sink->data = p;
-  snprintf(p->dir, sizeof p->dir, "%s/frames", dir);
-  snprintf(p->name, sizeof p->name, "%s", s->name);
-  if (mkdir(p->dir, 0777) != 0 && errno != EEXIST)
-    return sph_error_at(err, SPH_ERR_IO, p->dir, 0, 0, NULL,
-                        "cannot create the frames folder: %s", strerror(errno));
-  size_t n = sim->ps->n ? sim->ps->n : 1;
-  p->xyz = malloc(3 * n * sizeof *p->xyz);
-  p->rgb = malloc(3 * n);
-  p->value = malloc(n * sizeof *p->value);
-  p->keep = malloc(n);
-  if (!p->xyz || !p->rgb || !p->value || !p->keep)
-    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
-  SPH_TRY(sph_image_create(&p->img, o->width, o->height, err));
-  SPH_TRY(sph_gl_create(o->width, o->height, &p->gl, err));
-  SPH_TRY(sph_text_create(NULL, &p->text, err));
-  /* range policy and map */
-  sph_field f = (sph_field)o->color_field;
-  p->fixed = !strcmp(o->range_mode, "fixed");
-  p->symmetric = !strcmp(o->range_mode, "symmetric");
-  if (p->fixed) {
-    p->lo = o->range[0];
-    p->hi = o->range[1];
-    p->have_range = 1;
-  }
-  int signed_field = sph_field_components(f) == 1 &&
-                     (p->symmetric || (p->fixed && p->lo < 0.0 && p->hi > 0.0));
-  p->map = signed_field ? SPH_CMAP_COOL_WARM : SPH_CMAP_VIRIDIS;
-  /* camera, cutaways and the reference outline */
-  png_view(sim, &p->view);
-  SPH_TRY(sph_view_check(&p->view, err));
-  SPH_TRY(cut_mask(sim, &p->view, p->keep, err));
-  for (size_t a = 0; a < sim->ps->n; ++a)
-    p->nkeep += p->keep[a];
-  for (int k = 0; k < 3; ++k)
-    p->plane[k] = -o->clip_normal[k];
-  p->plane[3] = o->clip_at;
-  if (o->ghost) {
-    const double *X = sim->ps->field[SPH_FIELD_POSITION0];
-    p->ghost_xyz = malloc(3 * n * sizeof *p->ghost_xyz);
-    p->ghost_rim = malloc(3 * n);
-    p->ghost_fill = malloc(3 * n);
-    if (!p->ghost_xyz || !p->ghost_rim || !p->ghost_fill)
-      return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
-    size_t m = 0;
-    for (size_t a = 0; a < sim->ps->n; ++a) {
-      if (!p->keep[a])
-        continue;
-      for (int k = 0; k < 3; ++k) {
-        p->ghost_xyz[3 * m + k] = (float)X[3 * a + k];
-        p->ghost_rim[3 * m + k] = ghost_rim[k];
-        p->ghost_fill[3 * m + k] = ghost_fill[k];
-      }
-      ++m;
-    }
-  }
-  return SPH_OK;
-}
-
-static sph_status png_write(sph_sink *sink, const sph_frame *fr,
-                            sph_error *err) {
-  png_sink *p = sink->data;
-  const sph_scene *s = fr->sim->scene;
-  const sph_png_output *o = &s->output.png;
-  sph_field f = (sph_field)o->color_field;
-  const double *field = fr->ps->field[f];
-  const double *x = fr->ps->field[SPH_FIELD_POSITION];
-  size_t n = fr->ps->n;
-  int nc = sph_field_components(f);
-  double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
-  for (size_t a = 0; a < n; ++a) {
-    double v = field ? particle_value(field, nc, a) : NAN;
-    p->value[a] = v;
-    if (isfinite(v)) {
-      vmin = fmin(vmin, v);
-      vmax = fmax(vmax, v);
-      amax = fmax(amax, fabs(v));
-    }
-  }
-  /* grow-only range from the frames with a varying field */
-  if (!p->fixed && vmax > vmin) {
-    double lo_f = p->symmetric ? -amax : vmin,
-           hi_f = p->symmetric ? amax : vmax;
-    p->lo = p->have_range ? fmin(p->lo, lo_f) : lo_f;
-    p->hi = p->have_range ? fmax(p->hi, hi_f) : hi_f;
-    p->have_range = 1;
-  }
-  double lo = p->have_range ? p->lo : -1.0, hi = p->have_range ? p->hi : 1.0;
-  int clamped_low = 0, clamped_high = 0;
-  for (size_t a = 0; a < n; ++a) {
-    double v = p->value[a];
-    if (!isfinite(v))
-      continue;
-    clamped_low |= v < lo;
-    clamped_high |= v > hi;
-  }
-  /* the kept particles, packed in index order */
-  size_t m = 0;
-  for (size_t a = 0; a < n; ++a) {
-    if (!p->keep[a])
-      continue;
-    for (int c = 0; c < 3; ++c)
-      p->xyz[3 * m + c] = (float)x[3 * a + c];
-    double v = p->value[a];
+/* Renders one snapshot into frames/<scene>_NNNN.png: colours, the sphere
+ * pass, the overlay, the file (temporary name, then renamed). Errors name
+ * the file. Runs on the render thread (or the caller's without one). */
+static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
+  char path[1300];
+  snprintf(path, sizeof path, "%s/%s_%04d.png", p->dir, p->name, fr->index);
+  size_t m = p->nkeep;
+  double lo = fr->lo, hi = fr->hi;
+  for (size_t i = 0; i < m; ++i) {
+    double v = fr->value[i];
     if (isfinite(v))
-      sph_colormap_eval(p->map, (v - lo) / (hi - lo), p->rgb + 3 * m);
+      sph_colormap_eval(p->map, (v - lo) / (hi - lo), p->rgb + 3 * i);
     else
-      sph_colormap_nan(p->map, p->rgb + 3 * m);
-    ++m;
+      sph_colormap_nan(p->map, p->rgb + 3 * i);
   }
-  double dp = fr->sim->dp;
-  const double *plane = o->clip ? p->plane : NULL;
-  size_t ng = o->ghost ? p->nkeep : 0;
+  double dp = p->dp;
+  const double *plane = p->clip ? p->plane : NULL;
+  size_t ng = p->ghost ? m : 0;
   sph_gl_layer layers[3] = {
       {ng, p->ghost_xyz, (float)(GHOST_RIM * dp), p->ghost_rim, plane, 1},
       {ng, p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1},
-      {m, p->xyz, (float)(0.5 * dp), p->rgb, plane, 0}};
-  SPH_TRY(sph_gl_draw_layers(p->gl, &p->view, layers, 3, &p->img, err));
+      {m, fr->xyz, (float)(0.5 * dp), p->rgb, plane, 0}};
+  sph_error gerr;
+  sph_status st =
+      sph_gl_draw_layers(p->gl, &p->view, layers, 3, &p->img, &gerr);
+  if (st != SPH_OK)
+    return sph_error_at(err, st, path, 0, 0, NULL, "%s", gerr.message);
   /* overlay: colour bar at the right, label block at the top left */
   int H = p->img.height, W = p->img.width;
-  char title[96], label[256];
-  const char *unit = sph_field_unit(f);
-  snprintf(title, sizeof title, "%s%s%s%s%s", sph_field_name(f),
-           nc > 1 ? " magnitude" : "", unit && *unit ? " [" : "",
-           unit ? unit : "", unit && *unit ? "]" : "");
+  char label[256];
   sph_colorbar cb = {.map = p->map,
                      .min = lo,
                      .max = hi,
-                     .title = title,
-                     .clamped_low = clamped_low,
-                     .clamped_high = clamped_high,
+                     .title = p->title,
+                     .clamped_low = fr->clamped_low,
+                     .clamped_high = fr->clamped_high,
                      .x = W - W / 8,
                      .y = H / 5,
                      .width = W / 48 > 8 ? W / 48 : 8,
@@ -408,24 +346,297 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
   sph_colorbar_draw(&p->img, p->text, &cb);
   snprintf(label, sizeof label, "%s\nt = %.5f s", p->name, fr->time);
   sph_overlay_label(&p->img, p->text, W / 64, H / 36, label);
-  char path[1300];
-  snprintf(path, sizeof path, "%s/%s_%04d.png", p->dir, p->name, fr->index);
   return sph_image_write_png(path, &p->img, err);
 }
 
-static sph_status png_close(sph_sink *sink, sph_error *err) { return SPH_OK; }
+/* The renderer's GL context and font, made on the thread that renders. */
+static sph_status png_renderer_create(png_sink *p, sph_error *err) {
+  SPH_TRY(sph_gl_create(p->width, p->height, &p->gl, err));
+  return sph_text_create(NULL, &p->text, err);
+}
+
+static void png_renderer_destroy(png_sink *p) {
+  sph_gl_destroy(p->gl);
+  sph_text_destroy(p->text);
+  p->gl = NULL;
+  p->text = NULL;
+}
+
+/* Render thread: creates the renderer, then writes each frame handed over
+ * until told to quit; the context is made, used and destroyed here. */
+static void *png_thread(void *arg) {
+  png_sink *p = arg;
+  sph_error err;
+  sph_status st = png_renderer_create(p, &err);
+  pthread_mutex_lock(&p->mu);
+  p->ready = 1;
+  p->status = st;
+  if (st != SPH_OK)
+    p->error = err;
+  pthread_cond_broadcast(&p->cv);
+  while (st == SPH_OK) {
+    while (!p->queued && !p->quit)
+      pthread_cond_wait(&p->cv, &p->mu);
+    if (!p->queued)
+      break;
+    png_frame *fr = p->queued;
+    pthread_mutex_unlock(&p->mu);
+    /* the frame, outside the lock */
+    double t0 = sph_wtime();
+    sph_status fst = png_render(p, fr, &err);
+    double dt = sph_wtime() - t0;
+    pthread_mutex_lock(&p->mu);
+    p->busy += dt;
+    if (fst != SPH_OK && p->status == SPH_OK) {
+      p->status = fst;
+      p->error = err;
+    }
+    p->queued = NULL;
+    pthread_cond_broadcast(&p->cv);
+  }
+  pthread_mutex_unlock(&p->mu);
+  png_renderer_destroy(p);
+  return NULL;
+}
+
+/* Waits until every frame handed over is written; returns (and forgets) the
+ * render thread's first unreported error. */
+static sph_status png_wait(png_sink *p, sph_error *err) {
+  if (!p->started)
+    return SPH_OK;
+  pthread_mutex_lock(&p->mu);
+  while (p->queued || !p->ready)
+    pthread_cond_wait(&p->cv, &p->mu);
+  sph_status st = p->status;
+  if (st != SPH_OK && err)
+    *err = p->error;
+  p->status = SPH_OK;
+  pthread_mutex_unlock(&p->mu);
+  return st;
+}
+
+/* Lets the render thread finish the frame in flight, then ends it. */
+static void png_stop(png_sink *p) {
+  if (!p->started)
+    return;
+  pthread_mutex_lock(&p->mu);
+  p->quit = 1;
+  pthread_cond_broadcast(&p->cv);
+  pthread_mutex_unlock(&p->mu);
+  pthread_join(p->thread, NULL);
+  p->started = 0;
+}
+
+/* Allocates and fills everything but the renderer. */
+static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
+                            sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_png_output *o = &s->output.png;
+  snprintf(p->dir, sizeof p->dir, "%s/frames", dir);
+  snprintf(p->name, sizeof p->name, "%s", s->name);
+  if (mkdir(p->dir, 0777) != 0 && errno != EEXIST)
+    return sph_error_at(err, SPH_ERR_IO, p->dir, 0, 0, NULL,
+                        "cannot create the frames folder: %s", strerror(errno));
+  size_t n = sim->ps->n ? sim->ps->n : 1;
+  p->keep = malloc(n);
+  if (!p->keep)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  p->width = o->width;
+  p->height = o->height;
+  p->dp = sim->dp;
+  SPH_TRY(sph_image_create(&p->img, o->width, o->height, err));
+  /* field, range policy and map */
+  sph_field f = (sph_field)o->color_field;
+  p->field = f;
+  p->ncomp = sph_field_components(f);
+  p->fixed = !strcmp(o->range_mode, "fixed");
+  p->symmetric = !strcmp(o->range_mode, "symmetric");
+  if (p->fixed) {
+    p->lo = o->range[0];
+    p->hi = o->range[1];
+    p->have_range = 1;
+  }
+  int signed_field = p->ncomp == 1 &&
+                     (p->symmetric || (p->fixed && p->lo < 0.0 && p->hi > 0.0));
+  p->map = signed_field ? SPH_CMAP_COOL_WARM : SPH_CMAP_VIRIDIS;
+  const char *unit = sph_field_unit(f);
+  snprintf(p->title, sizeof p->title, "%s%s%s%s%s", sph_field_name(f),
+           p->ncomp > 1 ? " magnitude" : "", unit && *unit ? " [" : "",
+           unit ? unit : "", unit && *unit ? "]" : "");
+  /* camera, cutaways and the reference outline */
+  png_view(sim, &p->view);
+  SPH_TRY(sph_view_check(&p->view, err));
+  SPH_TRY(cut_mask(sim, &p->view, p->keep, err));
+  for (size_t a = 0; a < sim->ps->n; ++a)
+    p->nkeep += p->keep[a];
+  p->clip = o->clip;
+  p->ghost = o->ghost;
+  for (int k = 0; k < 3; ++k)
+    p->plane[k] = -o->clip_normal[k];
+  p->plane[3] = o->clip_at;
+  /* the snapshots and the colours of the kept particles */
+  size_t m = p->nkeep ? p->nkeep : 1;
+  p->rgb = malloc(3 * m);
+  if (!p->rgb)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  for (int i = 0; i < 2; ++i) {
+    p->slot[i].xyz = malloc(3 * m * sizeof *p->slot[i].xyz);
+    p->slot[i].value = malloc(m * sizeof *p->slot[i].value);
+    if (!p->slot[i].xyz || !p->slot[i].value)
+      return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  }
+  if (o->ghost) {
+    const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+    p->ghost_xyz = malloc(3 * m * sizeof *p->ghost_xyz);
+    p->ghost_rim = malloc(3 * m);
+    p->ghost_fill = malloc(3 * m);
+    if (!p->ghost_xyz || !p->ghost_rim || !p->ghost_fill)
+      return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+    size_t g = 0;
+    for (size_t a = 0; a < sim->ps->n; ++a) {
+      if (!p->keep[a])
+        continue;
+      for (int k = 0; k < 3; ++k) {
+        p->ghost_xyz[3 * g + k] = (float)X[3 * a + k];
+        p->ghost_rim[3 * g + k] = ghost_rim[k];
+        p->ghost_fill[3 * g + k] = ghost_fill[k];
+      }
+      ++g;
+    }
+  }
+  return SPH_OK;
+}
+
+static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
+                              const char *dir, int threaded, sph_error *err) {
+  png_sink *p = calloc(1, sizeof *p);
+  if (!p)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  sink->data = p;
+  sink->thread_seconds = 0.0;
+  p->threaded = threaded;
+  SPH_TRY(png_setup(p, sim, dir, err));
+  if (!threaded)
+    return png_renderer_create(p, err);
+  /* the render thread, which makes the GL context current on itself */
+  if (pthread_mutex_init(&p->mu, NULL) != 0)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink: no mutex");
+  if (pthread_cond_init(&p->cv, NULL) != 0) {
+    pthread_mutex_destroy(&p->mu);
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink: no condition variable");
+  }
+  p->locks_made = 1;
+  int rc = pthread_create(&p->thread, NULL, png_thread, p);
+  if (rc != 0)
+    return sph_error_set(err, SPH_ERR_NOMEM,
+                         "png sink: cannot start the render thread: %s",
+                         strerror(rc));
+  p->started = 1;
+  return png_wait(p, err);
+}
+
+static sph_status png_open(sph_sink *sink, const sph_sim *sim, const char *dir,
+                           sph_error *err) {
+  return png_open_as(sink, sim, dir, 1, err);
+}
+
+static sph_status png_open_sync(sph_sink *sink, const sph_sim *sim,
+                                const char *dir, sph_error *err) {
+  return png_open_as(sink, sim, dir, 0, err);
+}
+
+/* Copies what frame fr needs into snapshot s and advances the range (frame
+ * order, on the simulation thread). A non-finite position fails here, as
+ * the sphere pass would, so the frame is not written. */
+static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
+                               sph_error *err) {
+  const double *field = fr->ps->field[p->field];
+  const double *x = fr->ps->field[SPH_FIELD_POSITION];
+  size_t n = fr->ps->n, m = 0;
+  int nc = p->ncomp;
+  double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
+  for (size_t a = 0; a < n; ++a) {
+    double v = field ? particle_value(field, nc, a) : NAN;
+    if (isfinite(v)) {
+      vmin = fmin(vmin, v);
+      vmax = fmax(vmax, v);
+      amax = fmax(amax, fabs(v));
+    }
+    if (!p->keep[a])
+      continue;
+    for (int c = 0; c < 3; ++c)
+      s->xyz[3 * m + c] = (float)x[3 * a + c];
+    s->value[m++] = v;
+  }
+  for (size_t i = 0; i < 3 * m; ++i)
+    if (!isfinite(s->xyz[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "render: sphere %zu has a non-finite centre", i / 3);
+  /* grow-only range from the frames with a varying field */
+  if (!p->fixed && vmax > vmin) {
+    double lo_f = p->symmetric ? -amax : vmin,
+           hi_f = p->symmetric ? amax : vmax;
+    p->lo = p->have_range ? fmin(p->lo, lo_f) : lo_f;
+    p->hi = p->have_range ? fmax(p->hi, hi_f) : hi_f;
+    p->have_range = 1;
+  }
+  s->lo = p->have_range ? p->lo : -1.0;
+  s->hi = p->have_range ? p->hi : 1.0;
+  /* some finite value outside the range: the bar's end arrows */
+  s->clamped_low = vmin < s->lo;
+  s->clamped_high = vmax > s->hi;
+  s->time = fr->time;
+  s->index = fr->index;
+  return SPH_OK;
+}
+
+static sph_status png_write(sph_sink *sink, const sph_frame *fr,
+                            sph_error *err) {
+  png_sink *p = sink->data;
+  png_frame *s = &p->slot[p->next];
+  SPH_TRY(png_snapshot(p, fr, s, err));
+  if (!p->threaded)
+    return png_render(p, s, err);
+  /* the frame before is done (or failed): hand this one over */
+  SPH_TRY(png_wait(p, err));
+  pthread_mutex_lock(&p->mu);
+  p->queued = s;
+  pthread_cond_broadcast(&p->cv);
+  pthread_mutex_unlock(&p->mu);
+  p->next ^= 1;
+  return SPH_OK;
+}
+
+static sph_status png_flush(sph_sink *sink, sph_error *err) {
+  return png_wait(sink->data, err);
+}
+
+static sph_status png_close(sph_sink *sink, sph_error *err) {
+  png_sink *p = sink->data;
+  sph_status st = png_wait(p, err);
+  png_stop(p);
+  sink->thread_seconds = p->busy;
+  return st;
+}
 
 static void png_destroy(sph_sink *sink) {
   png_sink *p = sink->data;
   if (!p)
     return;
-  sph_gl_destroy(p->gl);
-  sph_text_destroy(p->text);
+  png_stop(p);
+  if (p->locks_made) {
+    pthread_cond_destroy(&p->cv);
+    pthread_mutex_destroy(&p->mu);
+  }
+  sink->thread_seconds = p->busy;
+  png_renderer_destroy(p);
   sph_image_destroy(&p->img);
-  free(p->xyz);
   free(p->rgb);
-  free(p->value);
   free(p->keep);
+  for (int i = 0; i < 2; ++i) {
+    free(p->slot[i].xyz);
+    free(p->slot[i].value);
+  }
   free(p->ghost_xyz);
   free(p->ghost_rim);
   free(p->ghost_fill);
@@ -437,6 +648,16 @@ const sph_sink_ops sph_png_sink_ops = {
     .name = "png",
     .open = png_open,
     .write = png_write,
+    .flush = png_flush,
+    .close = png_close,
+    .destroy = png_destroy,
+};
+
+const sph_sink_ops sph_png_sink_sync_ops = {
+    .name = "png",
+    .open = png_open_sync,
+    .write = png_write,
+    .flush = png_flush,
     .close = png_close,
     .destroy = png_destroy,
 };

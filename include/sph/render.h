@@ -9,6 +9,11 @@
 #include "sph/sink.h"
 #include "sph/status.h"
 
+/* Renders and writes each frame on a render thread of its own: `write`
+ * copies what the frame needs and returns (waiting only while the frame
+ * before is still rendering), `flush` and `close` wait until every frame is
+ * written, and a render thread error comes back from the next of them;
+ * thread_seconds is that thread's busy time. */
 extern const sph_sink_ops sph_png_sink_ops;
 
 /* Checks, before anything is written, that the scene's png block can give

@@ -40,6 +40,10 @@ struct sph_sink {
   int resume_frames;
   /* wall time spent in its hooks (kept by the caller; summary.json) */
   double seconds;
+  /* wall time the sink's own thread spent working, in parallel with the
+   * caller and not part of `seconds` (png: rendering; set by close and
+   * destroy, 0 for sinks without a thread) */
+  double thread_seconds;
 };
 
 /* energy.csv: time, energies, linear and angular momentum */

@@ -122,13 +122,17 @@ static sph_status write_scene_used(const sph_scene *s, const char *dir,
   return st;
 }
 
-/* One line: the wall time of each sink and its share of the run's. */
+/* One line: the wall time of each sink and its share of the run's, and
+ * the busy time of a sink's own thread (png: the render thread). */
 static void print_sink_times(const sph_sink *sinks, int nsinks, double wall) {
   printf("outputs:");
-  for (int i = 0; i < nsinks; ++i)
+  for (int i = 0; i < nsinks; ++i) {
     printf("%s %s %.2f s (%.1f %%)", i ? "," : "", sinks[i].ops->name,
            sinks[i].seconds,
            wall > 0.0 ? 100.0 * sinks[i].seconds / wall : 0.0);
+    if (sinks[i].thread_seconds > 0.0)
+      printf(" + render thread %.2f s", sinks[i].thread_seconds);
+  }
   printf(" of %.2f s wall\n", wall);
 }
 
@@ -277,7 +281,6 @@ int sph_cmd_run(int argc, char **argv) {
     }
   }
   sph_progress_finish(&prog);
-  double wall = sph_wtime() - wall0;
   int failed_step = st != SPH_OK && st != SPH_ERR_IO;
   if (st == SPH_OK && verdict->stable)
     completed = 1;
@@ -302,6 +305,8 @@ int sph_cmd_run(int argc, char **argv) {
       sinks[i].ops->destroy(&sinks[i]);
     sinks[i].seconds += sph_wtime() - t0;
   }
+  /* the run's wall time includes waiting for the last frames */
+  double wall = sph_wtime() - wall0;
   /* the animation of the frames, once the run has ended */
   sph_mp4_info mp4 = {0};
   sph_error merr;

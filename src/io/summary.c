@@ -83,7 +83,13 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     fputs(": ", f);
     json_number(f, mp4_seconds);
   }
-  fprintf(f, "},\n  \"particles\": %zu,\n  \"steps\": %lu,\n", sim->ps->n,
+  /* the sinks' own threads (png: rendering), in parallel with the run */
+  double thread_seconds = 0.0;
+  for (int i = 0; i < nsinks; ++i)
+    thread_seconds += sinks[i].thread_seconds;
+  fputs("},\n  \"render_thread_seconds\": ", f);
+  json_number(f, thread_seconds);
+  fprintf(f, ",\n  \"particles\": %zu,\n  \"steps\": %lu,\n", sim->ps->n,
           sim->steps);
   fputs("  \"wall_seconds\": ", f);
   json_number(f, wall_seconds);
