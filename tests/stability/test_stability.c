@@ -2,75 +2,9 @@
  * the indicator for its failure mode, measured through the same verdict the
  * sph command uses, plus a deliberately unstable configuration (no JST)
  * that the energy indicator must flag. */
-#include "test_util.h"
+#include "stability_run.h"
 
-#include <math.h>
-#include <stdio.h>
 #include <string.h>
-
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/stability.h"
-
-typedef struct outcome {
-  int stable;
-  char reason[256];
-  double t, cb_mean, cb_max, j_min, e0, e1;
-} outcome;
-
-/* runs scenes/<name>.yaml with overrides, observing every `every` s */
-static outcome run(const char *name, const char *const *sets, size_t nsets,
-                   double every) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/scenes/%s.yaml", SPH_SOURCE_DIR, name);
-  sph_scene *s;
-  sph_sim *sim;
-  sph_verdict *v;
-  sph_error err;
-  ck_assert_msg(sph_scene_load(&s, path, sets, nsets, &err) == SPH_OK, "%s",
-                err.message);
-  ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
-  ck_assert(sph_verdict_create(&v, sim, &err) == SPH_OK);
-  outcome o = {0};
-  double sum = 0.0;
-  int frames = 0;
-  for (int k = 0; v->stable; ++k) {
-    double next = fmin(s->t_end, every * k);
-    while (sim->t < next - 1e-12 * s->t_end) {
-      if (sph_sim_step(sim, next - sim->t, &err) != SPH_OK) {
-        sph_verdict_fail(v, sim->t, err.message);
-        break;
-      }
-    }
-    if (!v->stable)
-      break;
-    ck_assert(sim->method->derive(sim, &err) == SPH_OK);
-    sph_frame fr = {.time = sim->t, .sim = sim, .ps = sim->ps};
-    sim->method->energy(sim, &fr.kinetic, &fr.strain);
-    ck_assert_msg(sph_verdict_observe(v, &fr, &err) == SPH_OK, "%s",
-                  err.message);
-    if (frames++ > 0) /* the state at rest has no pressure to judge */
-      sum += v->checkerboard;
-    if (next >= s->t_end)
-      break;
-  }
-  o.stable = v->stable;
-  snprintf(o.reason, sizeof o.reason, "%s", v->reason);
-  o.t = sim->t;
-  o.cb_mean = frames > 1 ? sum / (frames - 1) : 0.0;
-  o.cb_max = v->checkerboard_max;
-  o.j_min = v->J_min;
-  o.e0 = v->energy0;
-  o.e1 = v->energy_final;
-  printf("%-32s %s t = %.4g  checkerboard mean %.3f max %.3f  J min %.3f  "
-         "energy %.4g -> %.4g %s\n",
-         name, o.stable ? "stable  " : "UNSTABLE", o.t, o.cb_mean, o.cb_max,
-         o.j_min, o.e0, o.e1, o.reason);
-  sph_verdict_destroy(v);
-  sph_sim_destroy(sim);
-  sph_scene_destroy(s);
-  return o;
-}
 
 START_TEST(twisting_column_nearly_incompressible) {
   /* A2 at nu = 0.499, 5 x 25 x 5, to 0.25 s. Seed 000 Fig. 28 shows {p,F}

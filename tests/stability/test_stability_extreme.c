@@ -1,0 +1,263 @@
+/* The extreme hard cases at CI size (BENCHMARKS.md A3, B10, B4 long time,
+ * A8 at 0.08 c0): each run's verdict and the indicator of its failure mode,
+ * through the same verdict the sph command uses (stability_run.h). */
+#include "stability_run.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- A3: twisting column at Omega = 300 rad/s --------------------------- */
+
+typedef struct tip_track {
+  size_t tip;
+  double max_disp; /* largest tip displacement seen, m */
+} tip_track;
+
+static void track_tip(sph_sim *sim, void *ctx) {
+  tip_track *tt = ctx;
+  const sph_particles *ps = sim->ps;
+  if (!tt->tip)
+    tt->tip = nearest_particle(ps, 0.5, 6.0, 0.5);
+  const double *x = ps->field[SPH_FIELD_POSITION] + 3 * tt->tip;
+  const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * tt->tip;
+  double d =
+      sqrt(pow(x[0] - X[0], 2) + pow(x[1] - X[1], 2) + pow(x[2] - X[2], 2));
+  tt->max_disp = fmax(tt->max_disp, d);
+}
+
+START_TEST(twisting_column_omega_300) {
+  /* scenes/twisting_column_extreme.yaml: {p,F} JST at 5 x 25 x 5, nu 0.49.
+   * The twist at the clamp peaks near 0.045 s with pairs at most 4 dp apart
+   * (energy bound 5 dp, threshold 6); the measured failure is a numerical
+   * fracture near the free end after that peak, without NaN or inversion.
+   * Seed 004 (bond-based F, SSP-RK3, 11 x 11 x 66) is stable to 92.1 ms. */
+  tip_track tt = {0, 0.0};
+  outcome o =
+      run_case("twisting_column_extreme", NULL, 0, 0.0025, track_tip, &tt);
+  show("A3 twisting column Omega 300", &o,
+       "tripped at %.4g s, tip moved %.3g m", o.t_tripped, tt.max_disp);
+  ck_assert_msg(!o.stable && strstr(o.reason, "numerical fracture"),
+                "expected the numerical fracture of tl-jst: %s",
+                o.stable ? "stable" : o.reason);
+  ck_assert_msg(o.t_tripped > 0.045 && o.t_tripped < 0.1,
+                "tripped at %g s, not after the twist peak", o.t_tripped);
+  ck_assert(!o.nan);
+  ck_assert_msg(o.j_min > 0.0, "J min %g", o.j_min);
+  ck_assert_msg(o.stretch_max > 6.0 && o.pairs_over > 0, "stretch %g dp",
+                o.stretch_max);
+}
+END_TEST
+
+/* ---- B10: pulling column --------------------------------------------------
+ */
+
+typedef struct pull_track {
+  size_t *top; /* particles of the pulled face */
+  size_t ntop;
+  double stretch_pct; /* (L' - L) / L x 100 at the latest frame */
+  double prev_pct;    /* at the frame before */
+} pull_track;
+
+static void track_pull(sph_sim *sim, void *ctx) {
+  pull_track *pt = ctx;
+  const sph_particles *ps = sim->ps;
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  const double *x = ps->field[SPH_FIELD_POSITION];
+  if (!pt->top) {
+    pt->top = malloc(ps->n * sizeof *pt->top);
+    ck_assert_ptr_nonnull(pt->top);
+    for (size_t a = 0; a < ps->n; ++a)
+      if (fabs(X[3 * a + 1] - 6.0) < 1e-9)
+        pt->top[pt->ntop++] = a;
+    ck_assert(pt->ntop > 0);
+  }
+  double y = 0.0;
+  for (size_t k = 0; k < pt->ntop; ++k)
+    y += x[3 * pt->top[k] + 1];
+  pt->prev_pct = pt->stretch_pct;
+  pt->stretch_pct = (y / (double)pt->ntop - 6.0) / 6.0 * 100.0;
+}
+
+START_TEST(pulling_column) {
+  /* scenes/pulling_column.yaml, {p,F} JST at 5 x 25 x 5, to 300 % stretch
+   * (t = 1.8 s). Seed 004's JST-SPH (12 x 12 x 72) reaches 421.9 % before
+   * its NaN; this tl-jst does not reach 300 %: an odd-even (hourglass)
+   * mode of the axial spacing grows from the clamped and the pulled faces
+   * until particles pass each other, which the fracture indicator sees.
+   * Measured (scene comment): the largest initially adjacent distance stays
+   * within 1.31 lambda dp (a uniform stretch lambda puts axial neighbours
+   * lambda dp apart) up to 150 % and trips the threshold at 161.7 %; the
+   * variants tried fail between 117 and 183 %. The test asserts that
+   * documented failure mode: stable beyond 100 % (lambda = 2), tripped by
+   * the fracture indicator before 300 %, no NaN and J > 0 throughout. */
+  pull_track pt = {0};
+  outcome o = run_case("pulling_column", NULL, 0, 0.01, track_pull, &pt);
+  show("B10 pulling column", &o,
+       "stretch %.1f %% at the trip (%.1f %% at the frame before)",
+       pt.stretch_pct, pt.prev_pct);
+  free(pt.top);
+  ck_assert_msg(!o.stable && strstr(o.reason, "numerical fracture"),
+                "expected the numerical fracture of tl-jst: %s",
+                o.stable ? "stable to 300 %" : o.reason);
+  ck_assert_msg(pt.prev_pct > 100.0 && pt.stretch_pct < 300.0,
+                "tripped at %g %% stretch", pt.stretch_pct);
+  ck_assert(!o.nan);
+  ck_assert_msg(o.j_min > 0.0, "J min %g", o.j_min);
+}
+END_TEST
+
+/* ---- B4: oscillating plate over 30 periods --------------------------------
+ */
+
+typedef struct plate_track {
+  int init;
+  size_t tip;
+  double y_prev, t_prev;
+  int periods;             /* upward zero crossings of the tip deflection */
+  double lo, hi;           /* extremes in the current period */
+  double amp_first;        /* half the peak-to-peak of the first period */
+  double amp_last;         /* the same for the latest complete period */
+  double t_cross;          /* time of the latest upward crossing */
+  double period_first;     /* length of the first period */
+  double period_last;      /* and of the latest */
+  double xsum, xn, x_last; /* mean axial tip displacement per period */
+} plate_track;
+
+static void track_plate(sph_sim *sim, void *ctx) {
+  plate_track *pt = ctx;
+  const sph_particles *ps = sim->ps;
+  if (!pt->init) {
+    pt->init = 1;
+    pt->tip = nearest_particle(ps, 0.2, 0.0, 0.0);
+    pt->lo = INFINITY;
+    pt->hi = -INFINITY;
+  }
+  const double *x = ps->field[SPH_FIELD_POSITION] + 3 * pt->tip;
+  const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * pt->tip;
+  double y = x[1] - X[1], t = sim->t;
+  if (t > 0.01 && pt->y_prev < 0.0 && y >= 0.0) {
+    double tc = pt->t_prev + (t - pt->t_prev) * -pt->y_prev / (y - pt->y_prev);
+    double amp = 0.5 * (pt->hi - pt->lo);
+    if (++pt->periods == 1) {
+      pt->amp_first = amp;
+      pt->period_first = tc;
+    }
+    pt->amp_last = amp;
+    pt->period_last = tc - pt->t_cross;
+    pt->t_cross = tc;
+    pt->x_last = pt->xsum / pt->xn;
+    pt->lo = INFINITY;
+    pt->hi = -INFINITY;
+    pt->xsum = pt->xn = 0.0;
+  }
+  pt->lo = fmin(pt->lo, y);
+  pt->hi = fmax(pt->hi, y);
+  pt->xsum += x[0] - X[0];
+  pt->xn += 1.0;
+  pt->y_prev = y;
+  pt->t_prev = t;
+}
+
+START_TEST(oscillating_plate_30_periods) {
+  /* B4 with ENOG at H/dp = 5 (spacing 0.004, the 0.016 m root of 4
+   * layers), v_f 0.01, for 9 s: more than 30 periods (seed 002 Fig. 7 runs
+   * 30+ at H/dp 10). The Riemann dissipation only removes energy: the
+   * energy may not rise; measured -0.61 % by 9 s, bound 2 %. The amplitude
+   * of the mode goes as the square root of its energy; the stated fraction,
+   * 0.95 of the first period's amplitude, is a loss of 10 % of the energy
+   * (16 times the measured loss; OAS "exhibits rapid energy decay").
+   * Measured: the last period's amplitude is 1.03 times the first's, since
+   * the plate also creeps: the tip's mean axial displacement grows by about
+   * 1 mm/s (9.7 mm by 9 s; half the rate at H/dp 10), which lengthens the
+   * period from 0.271 to 0.300 s and the tip's lever. */
+  const char *sets[] = {"bodies.0.particles.spacing=0.004",
+                        "bodies.0.shape.box.min=[-0.016,-0.01]", "time.end=9"};
+  plate_track pt = {0};
+  outcome o =
+      run_case("oscillating_plate_2d", sets, 3, 0.005, track_plate, &pt);
+  show("B4 plate H/dp 5, 9 s", &o,
+       "%d periods (first %.4f s, last %.4f s), amplitude first %.5f last "
+       "%.5f (ratio %.4f), energy change %.2e, mean axial tip displacement "
+       "over the last period %.2e m",
+       pt.periods, pt.period_first, pt.period_last, pt.amp_first, pt.amp_last,
+       pt.amp_last / pt.amp_first, (o.e1 - o.e0) / o.e0, pt.x_last);
+  ck_assert_msg(o.stable, "%s", o.reason);
+  ck_assert_int_ge(pt.periods, 30);
+  ck_assert_msg(o.e_max <= o.e0 && o.e1 > 0.98 * o.e0,
+                "energy %g -> %g (max %g)", o.e0, o.e1, o.e_max);
+  ck_assert_msg(pt.amp_last > 0.95 * pt.amp_first, "amplitude %g -> %g",
+                pt.amp_first, pt.amp_last);
+}
+END_TEST
+
+/* ---- A8: colliding rings at 0.08 c0 ----------------------------------------
+ */
+
+typedef struct rings_track {
+  int frames;
+  double ke0;    /* kinetic energy at t = 0 */
+  double vx_end; /* mean x velocity of the left ring at the latest frame */
+} rings_track;
+
+static void track_rings(sph_sim *sim, void *ctx) {
+  rings_track *rt = ctx;
+  const sph_particles *ps = sim->ps;
+  const double *m = ps->field[SPH_FIELD_MASS];
+  const double *v = ps->field[SPH_FIELD_VELOCITY];
+  if (rt->frames++ == 0) {
+    double k, st;
+    sim->method->energy(sim, &k, &st);
+    rt->ke0 = k;
+  }
+  double mv = 0.0, mass = 0.0;
+  for (size_t a = 0; a < ps->n; ++a)
+    if (ps->body[a] == 0) {
+      mv += m[a] * v[3 * a];
+      mass += m[a];
+    }
+  rt->vx_end = mv / mass;
+}
+
+START_TEST(rings_enog_bounce_without_fracture) {
+  /* A8 at v0 = 0.08 c0, dp = 0.002, ENOG, to 0.012 s: seed 002 Fig. 18
+   * (no fracture, no zig-zag; SPH-OAS fractures from 0.005 s). The verdict
+   * keeps its defaults: fracture beyond 2 dp (OG passes it at 0.0011 s),
+   * zig-zag above 0.5. Measured: 1.78 dp, zig-zag 0.473. */
+  const char *sets[] = {"method.shear=laplacian",
+                        "time.end=0.012",
+                        "bodies.0.particles.spacing=0.002",
+                        "bodies.1.particles.spacing=0.002",
+                        "bodies.0.initial_velocity.uniform=[9.4280904,0,0]",
+                        "bodies.1.initial_velocity.uniform=[-9.4280904,0,0]"};
+  rings_track rt = {0};
+  outcome o = run_case("colliding_rings", sets, 6, 0.0002, track_rings, &rt);
+  double v0 = 9.4280904, area = M_PI * (0.04 * 0.04 - 0.03 * 0.03);
+  double ke = 0.5 * 1200 * area * v0 * v0;
+  show("A8 rings 0.08 c0 ENOG", &o,
+       "kinetic energy per ring %.3f (1/2 rho A v0^2 = %.3f), left ring x "
+       "velocity at 0.012: %.3f m/s",
+       0.5 * rt.ke0, ke, rt.vx_end);
+  ck_assert_msg(o.stable && o.t >= 0.012 - 1e-12, "%s", o.reason);
+  ck_assert_msg(fabs(0.5 * rt.ke0 - ke) < 0.01 * ke, "kinetic %g vs %g",
+                0.5 * rt.ke0, ke);
+  ck_assert_msg(o.stretch_max < SPH_FRACTURE_DP && o.pairs_over == 0,
+                "stretch %g dp", o.stretch_max);
+  ck_assert_msg(o.zigzag_max < SPH_ZIGZAG_MAX, "zig-zag %g", o.zigzag_max);
+  ck_assert_msg(rt.vx_end < 0.0, "the rings did not bounce (%g)", rt.vx_end);
+}
+END_TEST
+
+int main(void) {
+  Suite *s = suite_create("stability_extreme");
+  TCase *tc = tcase_create("extreme cases");
+  tcase_set_timeout(tc, 900);
+  tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
+  tcase_add_test(tc, twisting_column_omega_300);
+  tcase_add_test(tc, pulling_column);
+  tcase_add_test(tc, oscillating_plate_30_periods);
+  tcase_add_test(tc, rings_enog_bounce_without_fracture);
+  suite_add_tcase(s, tc);
+  return sph_test_run(s);
+}
