@@ -32,7 +32,7 @@
  * is still being rendered; `flush` and `close` wait for every frame handed
  * over. The render thread's first error (naming the frame's file) is
  * returned by the next write, flush or close. sph_png_sink_sync_ops
- * (png_sink_impl.h) renders on the calling thread instead. */
+ * (sph/render.h) renders on the calling thread instead. */
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
@@ -43,7 +43,6 @@
 
 #include "gl_impl.h"
 #include "overlay_impl.h"
-#include "png_sink_impl.h"
 #include "sph/geometry.h"
 #include "sph/image.h"
 #include "sph/render.h"

@@ -15,6 +15,12 @@
  * written, and a render thread error comes back from the next of them;
  * thread_seconds is that thread's busy time. */
 extern const sph_sink_ops sph_png_sink_ops;
+/* The same frames, each drawn, composited and written inside `write` on
+ * the calling thread: for runs whose OpenMP team already takes every core,
+ * where a render thread would compete with it (and with spinning OpenMP
+ * barriers, slow it down), and the reference the threaded sink is tested
+ * against (tests/unit/test_png_async.c). */
+extern const sph_sink_ops sph_png_sink_sync_ops;
 
 /* Checks, before anything is written, that the scene's png block can give
  * a picture: a usable camera, not inside a body (3D), a clip/cut that keeps

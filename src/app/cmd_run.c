@@ -217,8 +217,13 @@ int sph_cmd_run(int argc, char **argv) {
     sinks[nsinks++] = (sph_sink){.ops = &sph_vtk_sink_ops};
   if (scene->output.nprobes)
     sinks[nsinks++] = (sph_sink){.ops = &sph_probe_sink_ops};
-  if (scene->output.png.enabled)
-    sinks[nsinks++] = (sph_sink){.ops = &sph_png_sink_ops};
+  if (scene->output.png.enabled) {
+    /* a render thread only where a core is left for it */
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    sinks[nsinks++] =
+        (sph_sink){.ops = sim->threads < cores ? &sph_png_sink_ops
+                                               : &sph_png_sink_sync_ops};
+  }
   sph_verdict *verdict = NULL;
   int index = 0;
   st = sph_verdict_create(&verdict, sim, &err);

@@ -19,7 +19,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "png_sink_impl.h"
 #include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
