@@ -31,6 +31,9 @@ int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
                        const char *command);
 
 /* The shipped scenes folder and the default scene. */
+/* mkdir -p: 0, or -1 with errno set */
+int sph_app_mkdir_p(const char *path);
+
 const char *sph_app_scenes_dir(void);
 const char *sph_app_default_scene(void);
 

@@ -21,19 +21,6 @@
 #include "sph/sink.h"
 #include "sph/stability.h"
 
-static int mkdir_p(const char *path) {
-  char buf[1024];
-  snprintf(buf, sizeof buf, "%s", path);
-  for (char *p = buf + 1; *p; ++p)
-    if (*p == '/') {
-      *p = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return -1;
-      *p = '/';
-    }
-  return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
-}
-
 static int file_exists(const char *dir, const char *name) {
   char path[1200];
   struct stat st;
@@ -198,7 +185,7 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  if (mkdir_p(dir) != 0) {
+  if (sph_app_mkdir_p(dir) != 0) {
     fprintf(stderr, "sph: cannot create the output folder %s: %s\n", dir,
             strerror(errno));
     sph_sim_destroy(sim);

@@ -249,19 +249,6 @@ static int validate(study *s, const study_args *a, int *checkpoint_off) {
   return SPH_EXIT_OK;
 }
 
-static int mkdir_p(const char *path) {
-  char buf[1024];
-  snprintf(buf, sizeof buf, "%s", path);
-  for (char *p = buf + 1; *p; ++p)
-    if (*p == '/') {
-      *p = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return -1;
-      *p = '/';
-    }
-  return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
-}
-
 static double number(const sph_node *map, const char *key) {
   const sph_node *n = map ? sph_node_child(map, key) : NULL;
   double x;
@@ -463,7 +450,7 @@ static int run_study(study *s, study_args *a) {
   }
   char runs[1100];
   snprintf(runs, sizeof runs, "%s/runs", s->dir);
-  if (mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {
+  if (sph_app_mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {
     fprintf(stderr, "sph study: cannot write %s: %s\n", s->dir,
             strerror(errno));
     return SPH_EXIT_FAIL;
@@ -483,7 +470,7 @@ static int run_study(study *s, study_args *a) {
       continue;
     char rundir[1200];
     snprintf(rundir, sizeof rundir, "%s/%03d", runs, c->index);
-    if (mkdir_p(rundir) != 0) {
+    if (sph_app_mkdir_p(rundir) != 0) {
       fprintf(stderr, "sph study: cannot create %s: %s\n", rundir,
               strerror(errno));
       return SPH_EXIT_FAIL;

@@ -1,9 +1,11 @@
 /* sph: a headless simulator for large-strain elastic solid dynamics with
  * SPH. Dispatches to the sub-commands (DESIGN.md sec. 1). */
+#include <errno.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "app/app_impl.h"
 #include "sph/render.h"
@@ -55,6 +57,19 @@ void sph_app_print_error(const sph_error *err) {
   char buf[2048];
   sph_error_format(err, buf, sizeof buf);
   fprintf(stderr, "sph: %s\n", buf);
+}
+
+int sph_app_mkdir_p(const char *path) {
+  char buf[1024];
+  snprintf(buf, sizeof buf, "%s", path);
+  for (char *p = buf + 1; *p; ++p)
+    if (*p == '/') {
+      *p = '\0';
+      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+        return -1;
+      *p = '/';
+    }
+  return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
 }
 
 int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
