@@ -6,6 +6,10 @@
  *    times its initial value (only for scenes without prescribed velocities
  *    or body forces, whose external work is not tracked);
  *    the kinetic energy alone above the same bound of the initial total;
+ *    growth below SPH_ENERGY_FLOOR sum m c0^2 (c0 the p-wave speed; the
+ *    energy of a uniform strain of about 1e-10, 1e12 times the round-off
+ *    energy of double-precision states) is never judged, so a body at rest
+ *    does not trip on round-off;
  *  - pressure checkerboard: the red-black mode fraction of BENCHMARKS.md
  *    D.3, C = |sum V s (p - pbar)| / sqrt(sum V * sum V (p - pbar)^2) with
  *    s_a = (-1)^(i+j+k) the parity of the particle's lattice index (bodies
@@ -23,22 +27,28 @@
  *    physical stretches beyond about 1.4 raise `stability: {fracture_dp}`;
  *  - zig-zag (hourglass) pattern of the von Mises stress s (seed 002 Fig. 1c,
  *    9): R = sqrt(sum V (s - s~)^2) / sqrt(sum V (s - sbar)^2), s~_a the
- *    Shepard average of s over a's neighbours of the same body in the
- *    current configuration (Wendland C2, h = 1.3 dp, a itself excluded) and
- *    sbar the volume-weighted mean; NaN when the field is uniform (spread
- *    below SPH_ZIGZAG_FLOOR times the largest shear modulus). Measured in
- *    tests/unit/test_verdict.c on lattices jittered by 0.25 dp (2D 20 x 20,
- *    3D 10 x 10 x 10): smooth linear / quadratic fields 0.030 / 0.044 (2D),
- *    0.060 / 0.086 (3D); the same plus an alternation +-0.2 (max - min)
- *    0.942 / 0.870 (2D), 0.864 / 0.814 (3D); +-0.1: 0.58 / 0.51, 0.55 /
- *    0.50; a pure alternation 1.42 (2D), 1.23 (3D). Tripped above
- *    SPH_ZIGZAG_MAX = 0.5: 5.8 times the roughest smooth field, 1.6 times
- *    below the mildest 20 % alternation, i.e. alternations of more than
- *    about 10 % of the field's range. Fields resolved by few particles are
- *    rough too: the shipped tl-jst scenes measure 0.12 (swinging cube) to
- *    0.56 (twisting column, 5 across), 0.90 (spinning cube, 6 across) and
- *    1.03 (inertial punch, stress concentration), with no red-black
- *    pattern; such scenes raise or switch off `stability: {zigzag_max}`.
+ *    value at x_a of the kernel-weighted linear least-squares fit of s over
+ *    a's neighbours of the same body in the current configuration
+ *    (Wendland C2, h = 1.3 dp, a itself excluded; the plain kernel average
+ *    where the neighbours lie on a line or a plane) and sbar the
+ *    volume-weighted mean; NaN when the field is uniform (spread below
+ *    SPH_ZIGZAG_FLOOR times the largest shear modulus). The fit reproduces
+ *    linear fields exactly, at a boundary too, so R measures what a smooth
+ *    field cannot explain. Measured in tests/unit/test_verdict.c on
+ *    lattices jittered by 0.25 dp (2D 20 x 20, 3D 10 x 10 x 10): linear /
+ *    quadratic fields 0 (round-off) / 0.010 (2D), 0 / 0.029 (3D); the same
+ *    plus an alternation +-0.2 (max - min) 1.05 / 0.97 (2D), 0.95 / 0.90
+ *    (3D); +-0.1: 0.64 / 0.57, 0.60 / 0.55; a pure alternation 1.58 (2D),
+ *    1.36 (3D). Tripped above SPH_ZIGZAG_MAX = 0.5: 17 times the roughest
+ *    smooth field, 1.8 times below the mildest 20 % alternation, i.e.
+ *    alternations of more than about 10 % of the field's range. Fields
+ *    resolved by few particles carry real grid-scale structure: the
+ *    shipped tl-jst scenes measure 0.05 (swinging cube) to 0.50 (twisting
+ *    column, 5 across), 0.68 (tensile cube), 0.96 (spinning cube, 6
+ *    across) and XXX (inertial punch, stress concentration), with no
+ *    red-black pattern; such scenes raise or switch off
+ *    `stability: {zigzag_max}`. ul-sph on the B4 plate to 0.3 s: ENOG
+ *    0.16, OG 1.10 (seed 002 Fig. 1c).
  * Both work from positions, reference positions, body ids and von Mises
  * only, so they apply to every method; their lists are allocated at
  * creation (the current-configuration lists grow only when an output
@@ -49,22 +59,52 @@
 #include "sph/neighbors.h"
 #include "sph/sink.h"
 
+/* The indicators, in the order a frame checks them: enum name, the key in
+ * summary.json and `sph run`'s verdict line. `step` is a time step that
+ * failed for a reason other than a non-finite value. */
+#define SPH_INDICATOR_LIST(X)                                                  \
+  X(SPH_INDICATOR_NAN, "nan")                                                  \
+  X(SPH_INDICATOR_JACOBIAN, "jacobian")                                        \
+  X(SPH_INDICATOR_ENERGY_GROWTH, "energy_growth")                              \
+  X(SPH_INDICATOR_CHECKERBOARD, "checkerboard")                                \
+  X(SPH_INDICATOR_FRACTURE, "fracture")                                        \
+  X(SPH_INDICATOR_ZIGZAG, "zigzag")                                            \
+  X(SPH_INDICATOR_STEP, "step")
+
+typedef enum sph_indicator {
+#define SPH_INDICATOR_ENUM(id, key) id,
+  SPH_INDICATOR_LIST(SPH_INDICATOR_ENUM)
+#undef SPH_INDICATOR_ENUM
+      SPH_INDICATOR_COUNT,
+  SPH_INDICATOR_NONE = -1
+} sph_indicator;
+
+/* The key of an indicator ("none" for SPH_INDICATOR_NONE). */
+const char *sph_indicator_key(sph_indicator i);
+
 #define SPH_ENERGY_GROWTH_MAX 0.05
+#define SPH_ENERGY_FLOOR 1e-20
 #define SPH_CHECKERBOARD_MAX 0.5
 #define SPH_FRACTURE_ADJACENT 1.5
 #define SPH_FRACTURE_DP 2.0
 #define SPH_ZIGZAG_H_OVER_DP 1.3
 #define SPH_ZIGZAG_FLOOR 1e-8
 #define SPH_ZIGZAG_MAX 0.5
+#define SPH_ZIGZAG_CONDITION 1e-3
 
 typedef struct sph_verdict {
   int stable;
   int nan;
   char reason[256];
   double t_tripped;
+  /* the first indicator that tripped and the time each one tripped (NaN:
+   * never); several can trip at the frame that ends the run */
+  sph_indicator first;
+  double tripped_at[SPH_INDICATOR_COUNT];
   int energy_tracked;
   int frames;
   double energy0, energy_max, energy_final;
+  double energy_floor; /* SPH_ENERGY_FLOOR sum m c0^2 */
   double J_min, J_max;
   double checkerboard, checkerboard_max;
   double lin0[3], ang0[3], lin_scale, ang_scale;
@@ -102,8 +142,14 @@ void sph_verdict_destroy(sph_verdict *v);
 sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *frame,
                                sph_error *err);
 
-/* Marks the run unstable for a reason found elsewhere (a failed step). */
-void sph_verdict_fail(sph_verdict *v, double t, const char *reason);
+/* Records that indicator i tripped at time t; the first one marks the run
+ * unstable with its reason. */
+void sph_verdict_fail(sph_verdict *v, sph_indicator i, double t,
+                      const char *reason);
+
+/* A time step that failed at time t with err: `nan` for a non-finite value,
+ * `step` for any other reason. */
+void sph_verdict_fail_step(sph_verdict *v, double t, const sph_error *err);
 
 /* The checkerboard indicator C of field f (see above); NaN when no particle
  * has a parity. */

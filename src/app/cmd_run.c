@@ -276,13 +276,8 @@ int sph_cmd_run(int argc, char **argv) {
   int failed_step = st != SPH_OK && st != SPH_ERR_IO;
   if (st == SPH_OK && verdict->stable)
     completed = 1;
-  if (failed_step && verdict) {
-    char msg[1024];
-    sph_error_format(&err, msg, sizeof msg);
-    sph_verdict_fail(verdict, sim->t, msg);
-    if (err.code == SPH_ERR_NUMERIC)
-      verdict->nan = 1;
-  }
+  if (failed_step && verdict)
+    sph_verdict_fail_step(verdict, sim->t, &err);
   /* close the sinks (files renamed into place) and write the summary */
   sph_error cerr;
   int io_failed = st == SPH_ERR_IO;
@@ -322,8 +317,10 @@ int sph_cmd_run(int argc, char **argv) {
     sph_app_print_error(&err);
     rc = SPH_EXIT_FAIL;
   } else if (verdict && !verdict->stable) {
-    printf("verdict: UNSTABLE - %s at t = %.6g s (%lu steps, %.2f s wall)\n",
-           verdict->reason, verdict->t_tripped, sim->steps, wall);
+    printf("verdict: UNSTABLE - %s tripped at t = %.6g s: %s (%lu steps, "
+           "%.2f s wall)\n",
+           sph_indicator_key(verdict->first), verdict->t_tripped,
+           verdict->reason, sim->steps, wall);
     rc = SPH_EXIT_FAIL;
   } else {
     printf("verdict: stable (%lu steps, %.2f s wall, %.3g particle-steps/s)\n",

@@ -2,12 +2,23 @@
 #include "sph/stability.h"
 
 #include "sph/geometry.h"
+#include "sph/material.h"
 #include "sph/neighbors.h"
+#include "sph/tensor.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+const char *sph_indicator_key(sph_indicator i) {
+  static const char *const keys[] = {
+#define SPH_INDICATOR_KEY(id, key) key,
+      SPH_INDICATOR_LIST(SPH_INDICATOR_KEY)
+#undef SPH_INDICATOR_KEY
+  };
+  return i >= 0 && i < SPH_INDICATOR_COUNT ? keys[i] : "none";
+}
 
 double sph_checkerboard_indicator(const signed char *parity,
                                   const double *volume, const double *f,
@@ -128,6 +139,9 @@ sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
   if (!v)
     return sph_error_set(err, SPH_ERR_NOMEM, "verdict");
   v->stable = 1;
+  v->first = SPH_INDICATOR_NONE;
+  for (int i = 0; i < SPH_INDICATOR_COUNT; ++i)
+    v->tripped_at[i] = NAN;
   v->J_min = INFINITY;
   v->J_max = -INFINITY;
   const sph_scene *s = sim->scene;
@@ -136,6 +150,13 @@ sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
     if (s->boundaries[k].kind == SPH_BC_VELOCITY)
       v->energy_tracked = 0;
   const sph_particles *ps = sim->ps;
+  const double *m = ps->field[SPH_FIELD_MASS];
+  for (size_t a = 0; m && a < ps->n; ++a) {
+    double c =
+        sph_material_wave_speed(&s->materials[s->bodies[ps->body[a]].material]);
+    v->energy_floor += m[a] * c * c;
+  }
+  v->energy_floor *= SPH_ENERGY_FLOOR;
   v->parity = malloc(ps->n ? ps->n : 1);
   if (!v->parity) {
     sph_verdict_destroy(v);
@@ -165,12 +186,25 @@ void sph_verdict_destroy(sph_verdict *v) {
   free(v);
 }
 
-void sph_verdict_fail(sph_verdict *v, double t, const char *reason) {
+void sph_verdict_fail(sph_verdict *v, sph_indicator i, double t,
+                      const char *reason) {
+  if (i >= 0 && i < SPH_INDICATOR_COUNT && isnan(v->tripped_at[i]))
+    v->tripped_at[i] = t;
+  v->nan |= i == SPH_INDICATOR_NAN;
   if (!v->stable)
     return;
   v->stable = 0;
+  v->first = i;
   v->t_tripped = t;
   snprintf(v->reason, sizeof v->reason, "%s", reason);
+}
+
+void sph_verdict_fail_step(sph_verdict *v, double t, const sph_error *err) {
+  char msg[sizeof v->reason];
+  sph_error_format(err, msg, sizeof msg);
+  sph_verdict_fail(
+      v, err->code == SPH_ERR_NUMERIC ? SPH_INDICATOR_NAN : SPH_INDICATOR_STEP,
+      t, msg);
 }
 
 static int all_finite(const double *f, size_t count) {
@@ -218,18 +252,57 @@ static sph_status zigzag_update(sph_verdict *v, const sph_particles *ps,
   const sph_neighbors *nl = v->nl;
   double *smooth = v->work;
   long n = (long)ps->n;
+  int dim = ps->dim;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     const sph_kernel *k = &v->body_kernel[ps->body[a]];
-    double sw = 0.0, sws = 0.0;
+    const double *xa = x + 3 * a;
+    /* kernel-weighted means of the offsets and of s */
+    double sw = 0.0, sws = 0.0, dm[3] = {0.0, 0.0, 0.0};
     for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
       size_t b = (size_t)nl->index[j];
-      double w = sph_kernel_eval(k, pair_distance(x, (size_t)a, b, ps->dim));
+      double w = sph_kernel_eval(k, pair_distance(x, (size_t)a, b, dim));
       sw += w;
       sws += w * s[b];
+      for (int c = 0; c < dim; ++c)
+        dm[c] += w * (x[3 * b + c] - xa[c]);
     }
     /* isolated particles (no neighbour within the support) are left out */
-    smooth[a] = sw > 0.0 ? sws / sw : NAN;
+    if (!(sw > 0.0)) {
+      smooth[a] = NAN;
+      continue;
+    }
+    double sm = sws / sw;
+    for (int c = 0; c < dim; ++c)
+      dm[c] /= sw;
+    /* weighted linear fit about the means, evaluated at x_a */
+    double C[9] = {0}, r[3] = {0.0, 0.0, 0.0};
+    for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
+      size_t b = (size_t)nl->index[j];
+      double w = sph_kernel_eval(k, pair_distance(x, (size_t)a, b, dim));
+      double e[3] = {0.0, 0.0, 0.0}, we[3] = {0.0, 0.0, 0.0};
+      for (int c = 0; c < dim; ++c) {
+        e[c] = x[3 * b + c] - xa[c] - dm[c];
+        we[c] = w * e[c];
+        r[c] += we[c] * (s[b] - sm);
+      }
+      sph_mat3_add_outer(C, we, e);
+    }
+    double scale = 0.0;
+    for (int c = 0; c < dim; ++c)
+      scale += C[4 * c] / dim;
+    for (int c = dim; c < 3; ++c)
+      C[4 * c] = scale;
+    double Ci[9] = {0}, g[3];
+    double det = sph_mat3_inverse(C, Ci);
+    /* neighbours on a line or a plane: no gradient, the plain average */
+    if (!(scale > 0.0) ||
+        !(det > SPH_ZIGZAG_CONDITION * scale * scale * scale)) {
+      smooth[a] = sm;
+      continue;
+    }
+    sph_mat3_vec(Ci, r, g);
+    smooth[a] = sm - (g[0] * dm[0] + g[1] * dm[1] + g[2] * dm[2]);
   }
   double sv = 0.0, mean = 0.0;
   for (long a = 0; a < n; ++a)
@@ -266,8 +339,7 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
       !all_finite(ps->field[SPH_FIELD_VELOCITY], 3 * n) ||
       !all_finite(ps->field[SPH_FIELD_STRESS], 9 * n) ||
       !isfinite(fr->kinetic + fr->strain)) {
-    v->nan = 1;
-    sph_verdict_fail(v, fr->time, "nan: non-finite state");
+    sph_verdict_fail(v, SPH_INDICATOR_NAN, fr->time, "nan: non-finite state");
     return SPH_OK;
   }
   /* Jacobian */
@@ -279,7 +351,7 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
   if (J && v->J_min <= 0.0) {
     snprintf(msg, sizeof msg, "J <= 0: inverted material (J min %.3g)",
              v->J_min);
-    sph_verdict_fail(v, fr->time, msg);
+    sph_verdict_fail(v, SPH_INDICATOR_JACOBIAN, fr->time, msg);
   }
   /* energy */
   double E = fr->kinetic + fr->strain;
@@ -288,24 +360,24 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
   }
   v->energy_max = E > v->energy_max ? E : v->energy_max;
   v->energy_final = E;
-  if (v->energy_tracked && v->energy0 > 0.0 &&
-      E > (1.0 + SPH_ENERGY_GROWTH_MAX) * v->energy0) {
+  double bound = fmax(SPH_ENERGY_GROWTH_MAX * v->energy0, v->energy_floor);
+  if (v->energy_tracked && v->energy0 > 0.0 && E > v->energy0 + bound) {
     snprintf(msg, sizeof msg,
              "energy growth: total energy %.4g exceeds the initial %.4g by "
              "more than %.0f %%",
              E, v->energy0, 100 * SPH_ENERGY_GROWTH_MAX);
-    sph_verdict_fail(v, fr->time, msg);
+    sph_verdict_fail(v, SPH_INDICATOR_ENERGY_GROWTH, fr->time, msg);
   }
   /* without external work the kinetic energy is bounded by the initial
    * total, whatever a method books as stored energy (ul-sph books the work
    * of its shear force, which a non-conservative force can drive negative) */
   if (v->energy_tracked && v->energy0 > 0.0 &&
-      fr->kinetic > (1.0 + SPH_ENERGY_GROWTH_MAX) * v->energy0) {
+      fr->kinetic > v->energy0 + bound) {
     snprintf(msg, sizeof msg,
              "energy growth: kinetic energy %.4g exceeds the initial total "
              "%.4g by more than %.0f %%",
              fr->kinetic, v->energy0, 100 * SPH_ENERGY_GROWTH_MAX);
-    sph_verdict_fail(v, fr->time, msg);
+    sph_verdict_fail(v, SPH_INDICATOR_ENERGY_GROWTH, fr->time, msg);
   }
   /* momentum drift */
   double lin[3], ang[3];
@@ -345,7 +417,7 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
       snprintf(msg, sizeof msg,
                "pressure checkerboard: indicator %.3g above %.2g",
                v->checkerboard, SPH_CHECKERBOARD_MAX);
-      sph_verdict_fail(v, fr->time, msg);
+      sph_verdict_fail(v, SPH_INDICATOR_CHECKERBOARD, fr->time, msg);
     }
   }
   /* numerical fracture */
@@ -356,7 +428,7 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
              "dp apart (largest %.3g dp)",
              v->fracture_pairs_over, v->fracture_pairs_over == 1 ? "" : "s",
              v->fracture_dp, v->fracture_max_stretch);
-    sph_verdict_fail(v, fr->time, msg);
+    sph_verdict_fail(v, SPH_INDICATOR_FRACTURE, fr->time, msg);
   }
   /* zig-zag pattern of the von Mises stress */
   sph_status st = zigzag_update(v, ps, err);
@@ -367,7 +439,7 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
     snprintf(msg, sizeof msg,
              "zig-zag pattern: von Mises roughness %.3g above %.3g", v->zigzag,
              v->zigzag_threshold);
-    sph_verdict_fail(v, fr->time, msg);
+    sph_verdict_fail(v, SPH_INDICATOR_ZIGZAG, fr->time, msg);
   }
   v->frames++;
   return SPH_OK;

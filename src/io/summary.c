@@ -123,6 +123,20 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_string(f, v->reason);
   fputs(",\n  \"tripped_at\": ", f);
   json_number(f, v->stable ? NAN : v->t_tripped);
+  fputs(",\n  \"first_indicator\": ", f);
+  if (v->stable)
+    fputs("null", f);
+  else
+    json_string(f, sph_indicator_key(v->first));
+  /* every indicator's trip time, null when it did not trip */
+  fputs(",\n  \"indicators\": {", f);
+  for (int i = 0; i < SPH_INDICATOR_COUNT; ++i) {
+    fputs(i ? ", " : "", f);
+    json_string(f, sph_indicator_key((sph_indicator)i));
+    fputs(": ", f);
+    json_number(f, v->tripped_at[i]);
+  }
+  fputc('}', f);
   if (sim->reference) {
     sph_reference_error e;
     sph_reference_errors(sim->reference, sim, &e);

@@ -79,5 +79,31 @@ fi
 [ $? -eq 2 ] && grep -qF -- "--overwrite" "$work/stderr" && ok || bad "second run without --overwrite"
 "$sph" run "$tiny" --out "$work/run" --quiet --overwrite >/dev/null 2>&1 && ok || bad "--overwrite"
 
+# an unstable run: exit 1, the verdict line names the first indicator and
+# its time, summary.json has it and every indicator's trip time
+"$sph" run "$src/scenes/twisting_column.yaml" --out "$work/unstable" --quiet \
+  --set method.cfl=1.5 --set time.end=0.1 --set output.every=0.05 \
+  --set output.png=off >"$work/stdout" 2>"$work/stderr"
+rc=$?
+if [ $rc -eq 1 ] &&
+  grep -qE '^verdict: UNSTABLE - nan tripped at t = [0-9.e-]+ s: ' "$work/stdout" &&
+  python3 - "$work/unstable/summary.json" <<'PY'; then
+import json, sys
+s = json.load(open(sys.argv[1]))
+i = s["indicators"]
+assert s["first_indicator"] == "nan" and s["stable"] is False, s
+assert i["nan"] == s["tripped_at"] and 0 < i["nan"] < 0.05, i
+assert all(i[k] is None for k in i if k != "nan"), i
+assert set(i) == {"nan", "jacobian", "energy_growth", "checkerboard",
+                  "fracture", "zigzag", "step"}, i
+PY
+  ok
+else
+  bad "unstable run (exit $rc): $(cat "$work/stdout" "$work/stderr")"
+fi
+"$sph" run "$tiny" --out "$work/run" --quiet --overwrite >"$work/stdout" 2>&1
+grep -q '"first_indicator": null' "$work/run/summary.json" && ok ||
+  bad "stable run: first_indicator not null"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -22,6 +22,8 @@ typedef struct outcome {
   char reason[256];
   double t;         /* time reached (the trip time of an unstable run) */
   double t_tripped; /* NaN when stable */
+  sph_indicator first;
+  double tripped_at[SPH_INDICATOR_COUNT]; /* NaN: did not trip */
   double cb_mean, cb_max, j_min, e0, e1, e_max;
   double stretch_max; /* largest initially adjacent distance over frames, dp */
   long pairs_over;    /* most pairs beyond stability.fracture_dp */
@@ -35,10 +37,11 @@ typedef struct outcome {
 /* called at every observed frame, after method->derive */
 typedef void (*frame_hook)(sph_sim *sim, void *ctx);
 
-/* runs scenes/<name>.yaml with overrides, observing every `every` s */
-static inline outcome run_case(const char *name, const char *const *sets,
-                               size_t nsets, double every, frame_hook hook,
-                               void *ctx) {
+/* runs scenes/<name>.yaml with overrides, observing every `every` s, to
+ * the end time or, unless keep_going, the first indicator that trips */
+static inline outcome run_frames(const char *name, const char *const *sets,
+                                 size_t nsets, double every, frame_hook hook,
+                                 void *ctx, int keep_going) {
   char path[512];
   snprintf(path, sizeof path, "%s/scenes/%s.yaml", SPH_SOURCE_DIR, name);
   struct timespec w0, w1;
@@ -54,15 +57,17 @@ static inline outcome run_case(const char *name, const char *const *sets,
   outcome o = {0};
   double sum = 0.0;
   int frames = 0;
-  for (int k = 0; v->stable; ++k) {
+  int failed = 0;
+  for (int k = 0; v->stable || keep_going; ++k) {
     double next = fmin(s->t_end, every * k);
     while (sim->t < next - 1e-12 * s->t_end) {
       if (sph_sim_step(sim, next - sim->t, &err) != SPH_OK) {
-        sph_verdict_fail(v, sim->t, err.message);
+        sph_verdict_fail_step(v, sim->t, &err);
+        failed = 1;
         break;
       }
     }
-    if (!v->stable)
+    if (failed || !(v->stable || keep_going))
       break;
     ck_assert(sim->method->derive(sim, &err) == SPH_OK);
     sph_frame fr = {.time = sim->t, .sim = sim, .ps = sim->ps};
@@ -82,6 +87,8 @@ static inline outcome run_case(const char *name, const char *const *sets,
   snprintf(o.reason, sizeof o.reason, "%s", v->reason);
   o.t = sim->t;
   o.t_tripped = v->stable ? NAN : v->t_tripped;
+  o.first = v->first;
+  memcpy(o.tripped_at, v->tripped_at, sizeof o.tripped_at);
   o.cb_mean = frames > 1 ? sum / (frames - 1) : 0.0;
   o.cb_max = v->checkerboard_max;
   o.j_min = v->J_min;
@@ -100,6 +107,12 @@ static inline outcome run_case(const char *name, const char *const *sets,
   sph_sim_destroy(sim);
   sph_scene_destroy(s);
   return o;
+}
+
+static inline outcome run_case(const char *name, const char *const *sets,
+                               size_t nsets, double every, frame_hook hook,
+                               void *ctx) {
+  return run_frames(name, sets, nsets, every, hook, ctx, 0);
 }
 
 /* one line: the verdict, the indicators, then the case's own figures */

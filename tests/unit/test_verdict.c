@@ -1,4 +1,5 @@
-/* The verdict's fracture and zig-zag indicators on frames built by hand:
+/* The verdict's fracture, zig-zag and energy indicators on frames built by
+ * hand:
  * scenes loaded from YAML, their particles generated, positions and von
  * Mises stress filled in directly (no method runs), observed through the
  * same sph_verdict_observe the sph command uses. */
@@ -66,6 +67,11 @@ static void fixture_make(fixture *f, sph_scene *s) {
   ck_assert(sph_particles_require(f->ps, SPH_FIELD_VON_MISES, &err) == SPH_OK);
   memcpy(f->ps->field[SPH_FIELD_POSITION], f->ps->field[SPH_FIELD_POSITION0],
          3 * f->ps->n * sizeof(double));
+  /* the masses a method would set: rho0 V0 of the rubber */
+  ck_assert(sph_particles_require(f->ps, SPH_FIELD_MASS, &err) == SPH_OK);
+  for (size_t a = 0; a < f->ps->n; ++a)
+    f->ps->field[SPH_FIELD_MASS][a] =
+        1100.0 * f->ps->field[SPH_FIELD_VOLUME0][a];
   f->sim.scene = s;
   f->sim.ps = f->ps;
   ck_assert_msg(sph_verdict_create(&f->v, &f->sim, &err) == SPH_OK, "%s",
@@ -219,6 +225,63 @@ START_TEST(bodies_parting_is_not_fracture) {
 }
 END_TEST
 
+/* ---- energy growth
+ * ----------------------------------------------------------- */
+
+static void observe_energy(fixture *f, double t, double kinetic,
+                           double strain) {
+  sph_error err;
+  sph_frame fr = {.time = t,
+                  .sim = &f->sim,
+                  .ps = f->ps,
+                  .kinetic = kinetic,
+                  .strain = strain};
+  ck_assert_msg(sph_verdict_observe(f->v, &fr, &err) == SPH_OK, "%s",
+                err.message);
+}
+
+START_TEST(energy_growth_above_round_off) {
+  /* the rubber's p-wave speed: c0^2 = E (1 - nu) / ((1 + nu)(1 - 2 nu)) /
+   * rho */
+  double c2 = 17e6 * 0.55 / (1.45 * 0.1) / 1100.0, mc2 = 0.0;
+  fixture f;
+  fixture_make(&f, box3(""));
+  const double *m = f.ps->field[SPH_FIELD_MASS];
+  for (size_t a = 0; a < f.ps->n; ++a)
+    mc2 += m[a] * c2;
+  ck_assert(fabs(f.v->energy_floor - SPH_ENERGY_FLOOR * mc2) <
+            1e-12 * f.v->energy_floor);
+  /* a body at rest with round-off energies (1e-30 m c0^2) growing tenfold
+   * is not judged */
+  observe_energy(&f, 0.0, 1e-30 * mc2, 0.0);
+  observe_energy(&f, 0.1, 5e-30 * mc2, 5e-30 * mc2);
+  ck_assert_msg(f.v->stable, "%s", f.v->reason);
+  fixture_free(&f);
+  /* a physical state (strain about 1e-3) growing 6 % trips, at its time */
+  fixture_make(&f, box3(""));
+  observe_energy(&f, 0.0, 0.0, 1e-6 * mc2);
+  observe_energy(&f, 0.1, 0.5e-6 * mc2, 0.54e-6 * mc2);
+  ck_assert_msg(f.v->stable, "4 %% growth tripped: %s", f.v->reason);
+  observe_energy(&f, 0.2, 0.5e-6 * mc2, 0.56e-6 * mc2);
+  ck_assert(!f.v->stable);
+  ck_assert_int_eq(f.v->first, SPH_INDICATOR_ENERGY_GROWTH);
+  ck_assert(f.v->tripped_at[SPH_INDICATOR_ENERGY_GROWTH] == 0.2);
+  ck_assert(f.v->t_tripped == 0.2);
+  for (int i = 0; i < SPH_INDICATOR_COUNT; ++i)
+    ck_assert(i == SPH_INDICATOR_ENERGY_GROWTH || isnan(f.v->tripped_at[i]));
+  fixture_free(&f);
+}
+END_TEST
+
+START_TEST(indicator_keys) {
+  ck_assert_str_eq(sph_indicator_key(SPH_INDICATOR_NAN), "nan");
+  ck_assert_str_eq(sph_indicator_key(SPH_INDICATOR_ZIGZAG), "zigzag");
+  ck_assert_str_eq(sph_indicator_key(SPH_INDICATOR_STEP), "step");
+  ck_assert_str_eq(sph_indicator_key(SPH_INDICATOR_NONE), "none");
+  ck_assert_str_eq(sph_indicator_key(SPH_INDICATOR_COUNT), "none");
+}
+END_TEST
+
 /* ---- zig-zag
  * ----------------------------------------------------------------- */
 
@@ -266,6 +329,9 @@ START_TEST(smooth_fields_are_not_zigzag) {
              dim, f.ps->n, q ? "quadratic" : "linear", R);
       ck_assert_msg(R < 0.5 * SPH_ZIGZAG_MAX, "%dD %s: R = %g", dim,
                     q ? "quadratic" : "linear", R);
+      /* the local linear fit reproduces a linear field, at the boundary
+       * too */
+      ck_assert_msg(q || R < 1e-9, "%dD linear: R = %g", dim, R);
       ck_assert_msg(f.v->stable, "%s", f.v->reason);
       fixture_free(&f);
     }
@@ -284,6 +350,8 @@ START_TEST(alternation_is_zigzag) {
       ck_assert_msg(R > 1.25 * SPH_ZIGZAG_MAX, "%dD %s: R = %g", dim,
                     q ? "quadratic" : "linear", R);
       ck_assert(!f.v->stable);
+      ck_assert_int_eq(f.v->first, SPH_INDICATOR_ZIGZAG);
+      ck_assert(f.v->tripped_at[SPH_INDICATOR_ZIGZAG] == 0.1);
       ck_assert_msg(strstr(f.v->reason, "zig-zag pattern"), "%s", f.v->reason);
       ck_assert(f.v->zigzag_max == R);
       fixture_free(&f);
@@ -331,6 +399,8 @@ int main(void) {
   tcase_add_test(tc, smooth_fields_are_not_zigzag);
   tcase_add_test(tc, alternation_is_zigzag);
   tcase_add_test(tc, zigzag_is_scale_free_and_can_be_off);
+  tcase_add_test(tc, energy_growth_above_round_off);
+  tcase_add_test(tc, indicator_keys);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }
