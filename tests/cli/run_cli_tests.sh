@@ -58,7 +58,7 @@ rc=$?
 
 # a tiny run end to end, then the overwrite guard; 3 x 7 x 3 particles
 # (0.5 m across, 1 m along) resolve nothing at the particle scale, so the
-# zig-zag indicator is off (its von Mises roughness reaches 1.15)
+# zig-zag indicator is off (its von Mises roughness reaches 1.24)
 tiny="$work/tiny.yaml"
 sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
   -e 's/every: 0.005/every: 0.005/' \
