@@ -257,15 +257,22 @@ static sph_status zigzag_update(sph_verdict *v, const sph_particles *ps,
   for (long a = 0; a < n; ++a) {
     const sph_kernel *k = &v->body_kernel[ps->body[a]];
     const double *xa = x + 3 * a;
-    /* kernel-weighted means of the offsets and of s */
+    /* kernel-weighted moments of the offsets d and of s, in one pass */
     double sw = 0.0, sws = 0.0, dm[3] = {0.0, 0.0, 0.0};
+    double C[9] = {0}, r[3] = {0.0, 0.0, 0.0};
     for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
       size_t b = (size_t)nl->index[j];
       double w = sph_kernel_eval(k, pair_distance(x, (size_t)a, b, dim));
+      double d[3] = {0.0, 0.0, 0.0}, wd[3] = {0.0, 0.0, 0.0};
+      for (int c = 0; c < dim; ++c) {
+        d[c] = x[3 * b + c] - xa[c];
+        wd[c] = w * d[c];
+        dm[c] += wd[c];
+        r[c] += wd[c] * s[b];
+      }
       sw += w;
       sws += w * s[b];
-      for (int c = 0; c < dim; ++c)
-        dm[c] += w * (x[3 * b + c] - xa[c]);
+      sph_mat3_add_outer(C, wd, d);
     }
     /* isolated particles (no neighbour within the support) are left out */
     if (!(sw > 0.0)) {
@@ -275,18 +282,12 @@ static sph_status zigzag_update(sph_verdict *v, const sph_particles *ps,
     double sm = sws / sw;
     for (int c = 0; c < dim; ++c)
       dm[c] /= sw;
-    /* weighted linear fit about the means, evaluated at x_a */
-    double C[9] = {0}, r[3] = {0.0, 0.0, 0.0};
-    for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j) {
-      size_t b = (size_t)nl->index[j];
-      double w = sph_kernel_eval(k, pair_distance(x, (size_t)a, b, dim));
-      double e[3] = {0.0, 0.0, 0.0}, we[3] = {0.0, 0.0, 0.0};
-      for (int c = 0; c < dim; ++c) {
-        e[c] = x[3 * b + c] - xa[c] - dm[c];
-        we[c] = w * e[c];
-        r[c] += we[c] * (s[b] - sm);
-      }
-      sph_mat3_add_outer(C, we, e);
+    /* weighted linear fit about the means, evaluated at x_a: covariances
+     * sum w (d - dm)(d - dm)^T and sum w (d - dm)(s - sm) */
+    for (int r0 = 0; r0 < dim; ++r0) {
+      r[r0] -= sw * dm[r0] * sm;
+      for (int c = 0; c < dim; ++c)
+        C[3 * r0 + c] -= sw * dm[r0] * dm[c];
     }
     double scale = 0.0;
     for (int c = 0; c < dim; ++c)
