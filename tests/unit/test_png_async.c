@@ -61,6 +61,17 @@ static void open_sink(sph_sink *sink, const sph_sink_ops *ops,
 }
 
 /* Whole file into memory; its size in *len. */
+/* the default scene's render-thread sink writing to <dir>/<name>; frames
+ * gets its frames folder */
+static void open_async(sph_sink *sink, const char *name, sph_scene **scene,
+                       sph_sim **sim, char *frames, size_t size) {
+  char out[256];
+  make_sim(NULL, 0, scene, sim);
+  snprintf(out, sizeof out, "%s/%s", dir, name);
+  snprintf(frames, size, "%s/frames", out);
+  open_sink(sink, &sph_png_sink_ops, *sim, out);
+}
+
 static unsigned char *slurp(const char *path, long *len) {
   FILE *f = fopen(path, "rb");
   ck_assert_msg(f != NULL, "missing %s", path);
@@ -211,12 +222,9 @@ static void assert_frame_error(sph_status st, const sph_error *err, int index) {
 START_TEST(test_thread_error) {
   sph_scene *scene;
   sph_sim *sim;
-  make_sim(NULL, 0, &scene, &sim);
-  char out[256], frames[300];
-  snprintf(out, sizeof out, "%s/error", dir);
-  snprintf(frames, sizeof frames, "%s/frames", out);
   sph_sink sink;
-  open_sink(&sink, &sph_png_sink_ops, sim, out);
+  char frames[300];
+  open_async(&sink, "error", &scene, &sim, frames, sizeof frames);
   sph_error err;
   sph_frame fr = frame_of(sim, 0);
   ck_assert_msg(sink.ops->write(&sink, &fr, &err) == SPH_OK, "%s", err.message);
@@ -262,12 +270,9 @@ END_TEST
 START_TEST(test_destroy_finishes) {
   sph_scene *scene;
   sph_sim *sim;
-  make_sim(NULL, 0, &scene, &sim);
-  char out[256], frames[300];
-  snprintf(out, sizeof out, "%s/destroy", dir);
-  snprintf(frames, sizeof frames, "%s/frames", out);
   sph_sink sink;
-  open_sink(&sink, &sph_png_sink_ops, sim, out);
+  char frames[300];
+  open_async(&sink, "destroy", &scene, &sim, frames, sizeof frames);
   sph_error err;
   for (int k = 0; k < 2; ++k) {
     sph_frame fr = frame_of(sim, k);

@@ -84,12 +84,20 @@ static void fixture_free(fixture *f) {
   sph_scene_destroy(f->s);
 }
 
-static void observe(fixture *f, double t) {
+/* a frame with the given energies */
+static void observe_energy(fixture *f, double t, double kinetic,
+                           double strain) {
   sph_error err;
-  sph_frame fr = {.time = t, .sim = &f->sim, .ps = f->ps};
+  sph_frame fr = {.time = t,
+                  .sim = &f->sim,
+                  .ps = f->ps,
+                  .kinetic = kinetic,
+                  .strain = strain};
   ck_assert_msg(sph_verdict_observe(f->v, &fr, &err) == SPH_OK, "%s",
                 err.message);
 }
+
+static void observe(fixture *f, double t) { observe_energy(f, t, 0.0, 0.0); }
 
 /* x <- X + (lambda - 1) X_c along the listed axes */
 static void stretch(fixture *f, const double lambda[3]) {
@@ -227,18 +235,6 @@ END_TEST
 
 /* ---- energy growth
  * ----------------------------------------------------------- */
-
-static void observe_energy(fixture *f, double t, double kinetic,
-                           double strain) {
-  sph_error err;
-  sph_frame fr = {.time = t,
-                  .sim = &f->sim,
-                  .ps = f->ps,
-                  .kinetic = kinetic,
-                  .strain = strain};
-  ck_assert_msg(sph_verdict_observe(f->v, &fr, &err) == SPH_OK, "%s",
-                err.message);
-}
 
 START_TEST(energy_growth_above_round_off) {
   /* the rubber's p-wave speed: c0^2 = E (1 - nu) / ((1 + nu)(1 - 2 nu)) /
