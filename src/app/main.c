@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "app/app_impl.h"
 #include "sph/render.h"
@@ -148,7 +149,24 @@ int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
   return SPH_EXIT_USAGE;
 }
 
+/* libgomp reads its wait policy once, when it is loaded, before main: a
+ * process that must change it starts itself again with it set. Unless the
+ * user chose (OMP_WAIT_POLICY or GOMP_SPINCOUNT), threads spin about a
+ * microsecond at a barrier, then sleep. libgomp's default spin (300,000
+ * turns) made a 2-thread run beside two busy processes 2-25x slower than one
+ * thread; sleeping at once (passive) made short steps 20-150 % slower on a
+ * quiet machine. README "Threads" has the figures. */
+static void short_spin_wait_policy(char **argv) {
+  if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT"))
+    return;
+  if (setenv("GOMP_SPINCOUNT", "1000", 1) != 0)
+    return;
+  execv("/proc/self/exe", argv);
+  /* not re-executed: the run goes on with libgomp's default policy */
+}
+
 int main(int argc, char **argv) {
+  short_spin_wait_policy(argv);
   if (argc < 2)
     return sph_cmd_run(argc, argv);
   const char *cmd = argv[1];

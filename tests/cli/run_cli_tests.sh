@@ -105,5 +105,29 @@ fi
 grep -q '"first_indicator": null' "$work/run/summary.json" && ok ||
   bad "stable run: first_indicator not null"
 
+# the OpenMP wait policy: without the user's choice a run spins briefly
+# (GOMP_SPINCOUNT=1000) then sleeps; a user's OMP_WAIT_POLICY or
+# GOMP_SPINCOUNT is kept as given
+spin_of() { # prints the GOMP_SPINCOUNT/OMP_WAIT_POLICY the running sph sees
+  env "$@" "$sph" run --out "$work/spin" --overwrite --quiet \
+    --set time.end=1 --set output.png=false --set output.vtk=false \
+    >/dev/null 2>&1 &
+  local pid=$! seen=""
+  for _ in $(seq 50); do
+    sleep 0.1
+    seen=$(tr '\0' '\n' <"/proc/$pid/environ" 2>/dev/null |
+      grep -E '^(GOMP_SPINCOUNT|OMP_WAIT_POLICY)=' | sort | tr '\n' ' ')
+    [ -n "$seen" ] && break
+  done
+  kill "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+  echo "$seen"
+}
+got=$(spin_of -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT)
+[ "$got" = "GOMP_SPINCOUNT=1000 " ] && ok || bad "default wait policy: '$got'"
+got=$(spin_of -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active)
+[ "$got" = "OMP_WAIT_POLICY=active " ] && ok || bad "user's OMP_WAIT_POLICY: '$got'"
+rm -rf "$work/spin"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
