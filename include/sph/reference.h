@@ -1,15 +1,18 @@
 /* Reference solutions a scene can name in its `reference:` block, used to
  * set the initial state and to measure errors:
  *   reference: {analytic: swinging_cube, U0: 5e-4, A: 1, B: 1, C: 1}
- * is the dilatational mode of the unit cube of seed 000 sec. 8.2 eq. 52,
- * u_i = U0 cos(w t) A_i f_i(X), w = sqrt(3)/2 c_d pi, with
+ * is the swinging cube of seed 000 sec. 8.2 eq. 52,
+ * u_i = U0 f_i(X) (m cos(w_d t) + (A_i - m) cos(w_s t)), m = (A + B + C)/3,
+ * w_d = sqrt(3)/2 c_d pi, w_s = sqrt(3)/2 c_s pi (exact for every A, B, C:
+ * the mean part is the dilatational mode, the zero-sum part a shear mode), with
  * f = (sin cos cos, cos sin cos, cos cos sin) of (pi X / 2) and the small
  * strain stress of the body's material. The initial state is F = I + grad u,
  * x = X + u and p = 0 (seed 000 sec. 8.2): methods that carry F as a
  * variable take F, those that derive it from the positions take x; methods
  * that cannot start deformed refuse the reference. Errors are L2 norms over the
  * particles (volume weighted), normalised by the amplitude of the exact field:
- * e_v by U0 w max|A_i|, e_P by the largest |P| at t = 0, e_u by U0.
+ * e_v by U0 max_i(w_d |m| + w_s |A_i - m|), e_P by the largest |P| at t = 0,
+ * e_u by U0.
  *
  *   reference: {period: {at: [0.2, 0], component: y}, value: 0.254,
  *               tolerance: 0.05}

@@ -1,5 +1,16 @@
 /* Reference solutions (see include/sph/reference.h): the swinging cube of
- * seed 000 sec. 8.2 eq. 52, and a measured period against a scalar value. */
+ * seed 000 sec. 8.2 eq. 52, and a measured period against a scalar value.
+ *
+ * Eq. 52 for any amplitudes (A1, A2, A3) = (A, B, C): with a = pi/2 and
+ * u_i = A_i f_i(X) g(t), f = (sin cos cos, cos sin cos, cos cos sin)(a X),
+ * lap f_i = -3 a^2 f_i and grad(div u)_i = -a^2 (A1 + A2 + A3) f_i g, so
+ * rho u'' = (lambda + mu) grad div u + mu lap u reads, per component,
+ * rho w^2 A_i = a^2 ((lambda + mu) sum_k A_k + 3 mu A_i).
+ * One frequency serves all three components only for A_i = m (dilatational,
+ * w_d = sqrt(3) a c_d) or sum_k A_k = 0 (shear, w_s = sqrt(3) a c_s); every
+ * mode is the sum of its mean part m = (A + B + C)/3 at w_d and its zero-sum
+ * part A_i - m at w_s. Both parts meet the symmetry (X_i = 0) and
+ * skew-symmetry (X_i = 1) planes. */
 #include "sph/reference.h"
 
 #include <math.h>
@@ -23,13 +34,15 @@ struct sph_reference {
   double obs[OBS_N];
   /* swinging cube */
   double U0, A[3];
-  double omega;        /* sqrt(3)/2 c_d pi */
+  double Ad[3], As[3]; /* dilatational and shear parts of A */
+  double omega_d;      /* sqrt(3)/2 c_d pi */
+  double omega_s;      /* sqrt(3)/2 c_s pi */
   double lambda, mu;   /* small strain moduli of the body */
   double P_amp, v_amp; /* normalisations */
 };
 
-/* displacement gradient at unit amplitude: G_ij = A_i d f_i / d X_j */
-static void mode(const sph_reference *r, const double X[3], double f[3],
+/* a mode of amplitudes A at U0 = 1: f_i = A_i f_i(X), G_ij = d f_i / d X_j */
+static void mode(const double A[3], const double X[3], double f[3],
                  double G[9]) {
   double s[3], c[3], h = M_PI / 2;
   for (int k = 0; k < 3; ++k) {
@@ -37,17 +50,33 @@ static void mode(const sph_reference *r, const double X[3], double f[3],
     c[k] = cos(h * X[k]);
   }
   for (int i = 0; i < 3; ++i) {
-    double v = r->A[i];
+    double v = A[i];
     for (int k = 0; k < 3; ++k)
       v *= k == i ? s[k] : c[k];
     f[i] = v;
     for (int j = 0; j < 3; ++j) {
-      double d = r->A[i] * h;
+      double d = A[i] * h;
       for (int k = 0; k < 3; ++k)
         d *= k == j ? (k == i ? c[k] : -s[k]) : (k == i ? s[k] : c[k]);
       G[3 * i + j] = d;
     }
   }
+}
+
+/* the exact displacement, velocity and displacement gradient at (X, t) */
+static void exact(const sph_reference *r, const double X[3], double t,
+                  double u[3], double v[3], double G[9]) {
+  double fd[3], Gd[9], fs[3], Gs[9];
+  mode(r->Ad, X, fd, Gd);
+  mode(r->As, X, fs, Gs);
+  const double cd = cos(r->omega_d * t), sd = sin(r->omega_d * t);
+  const double cs = cos(r->omega_s * t), ss = sin(r->omega_s * t);
+  for (int i = 0; i < 3; ++i) {
+    u[i] = r->U0 * (cd * fd[i] + cs * fs[i]);
+    v[i] = -r->U0 * (r->omega_d * sd * fd[i] + r->omega_s * ss * fs[i]);
+  }
+  for (int k = 0; k < 9; ++k)
+    G[k] = r->U0 * (cd * Gd[k] + cs * Gs[k]);
 }
 
 /* small strain stress of a displacement gradient */
@@ -106,9 +135,16 @@ static sph_status swinging_cube_create(sph_reference *r, const sph_scene *s,
   const sph_material *m = &s->materials[s->bodies[0].material];
   r->lambda = m->lambda;
   r->mu = m->mu;
-  r->omega = sqrt(3.0) / 2.0 * sph_material_wave_speed(m) * M_PI;
-  r->v_amp = r->U0 * r->omega *
-             fmax(fabs(r->A[0]), fmax(fabs(r->A[1]), fabs(r->A[2])));
+  r->omega_d = sqrt(3.0) / 2.0 * sph_material_wave_speed(m) * M_PI;
+  r->omega_s = sqrt(3.0) / 2.0 * sqrt(m->mu / m->density) * M_PI;
+  const double mean = (r->A[0] + r->A[1] + r->A[2]) / 3.0;
+  r->v_amp = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    r->Ad[i] = mean;
+    r->As[i] = r->A[i] - mean;
+    r->v_amp = fmax(r->v_amp, r->U0 * (r->omega_d * fabs(r->Ad[i]) +
+                                       r->omega_s * fabs(r->As[i])));
+  }
   r->kind = REF_SWINGING_CUBE;
   return SPH_OK;
 }
@@ -159,18 +195,16 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
   SPH_TRY(sph_particles_require(ps, SPH_FIELD_POSITION, err));
   rw->P_amp = 0.0;
   for (size_t a = 0; a < ps->n; ++a) {
-    double f[3], G[9], P[9];
-    mode(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, f, G);
+    double u[3], v[3], G[9], P[9];
     const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+    exact(r, X, 0.0, u, v, G);
     double *F = ps->field[SPH_FIELD_DEFGRAD] + 9 * a;
     for (int k = 0; k < 9; ++k)
-      F[k] = (k % 4 == 0) + r->U0 * G[k];
+      F[k] = (k % 4 == 0) + G[k];
     for (int c = 0; c < 3; ++c) {
-      ps->field[SPH_FIELD_POSITION][3 * a + c] = X[c] + r->U0 * f[c];
-      ps->field[SPH_FIELD_VELOCITY][3 * a + c] = 0.0;
+      ps->field[SPH_FIELD_POSITION][3 * a + c] = X[c] + u[c];
+      ps->field[SPH_FIELD_VELOCITY][3 * a + c] = v[c];
     }
-    for (int k = 0; k < 9; ++k)
-      G[k] *= r->U0;
     stress(r, G, P);
     rw->P_amp = fmax(rw->P_amp, sqrt(sph_mat3_ddot(P, P)));
   }
@@ -224,23 +258,18 @@ void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
     return;
   }
   const sph_particles *ps = sim->ps;
-  double t = sim->t, cw = cos(r->omega * t), sw = sin(r->omega * t);
   double sv = 0.0, ev = 0.0, eP = 0.0, eu = 0.0;
   for (size_t a = 0; a < ps->n; ++a) {
-    double f[3], G[9], P[9];
+    double uex[3], vex[3], G[9], P[9];
     const double V = ps->field[SPH_FIELD_VOLUME0][a];
-    mode(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, f, G);
-    for (int k = 0; k < 9; ++k)
-      G[k] *= r->U0 * cw;
+    exact(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, sim->t, uex, vex, G);
     stress(r, G, P);
     const double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * a;
     const double *u = ps->field[SPH_FIELD_DISPLACEMENT] + 3 * a;
     const double *Pn = ps->field[SPH_FIELD_PK1] + 9 * a;
     for (int i = 0; i < 3; ++i) {
-      double vex = -r->U0 * r->omega * sw * f[i];
-      double uex = r->U0 * cw * f[i];
-      ev += V * (v[i] - vex) * (v[i] - vex);
-      eu += V * (u[i] - uex) * (u[i] - uex);
+      ev += V * (v[i] - vex[i]) * (v[i] - vex[i]);
+      eu += V * (u[i] - uex[i]) * (u[i] - uex[i]);
     }
     for (int k = 0; k < 9; ++k)
       eP += V * (Pn[k] - P[k]) * (Pn[k] - P[k]);

@@ -1,7 +1,9 @@
 /* Reference solutions (include/sph/reference.h): the period measured from
  * zero crossings of a particle's displacement, its checkpoint state and its
  * input errors; the swinging cube's deformed initial state for methods that
- * carry F and for those that derive it from the positions. */
+ * carry F and for those that derive it from the positions; the swinging cube
+ * for non-equal (A, B, C) against an independent evaluation of eq. 52 that
+ * the test first shows to solve linear elastodynamics. */
 #include "test_util.h"
 
 #include <math.h>
@@ -170,6 +172,152 @@ START_TEST(cube_refused_by_ul_sph) {
 }
 END_TEST
 
+/* Independent evaluation of seed 000 eq. 52 for amplitudes A (E = 17e6,
+ * nu = 0.3, rho = 1100 as scenes/swinging_cube.yaml): the mean of A moves at
+ * the dilatational frequency, the rest at the shear frequency; with
+ * `one_frequency` everything moves at the dilatational one (the reference as
+ * it was before). */
+typedef struct {
+  double A[3], U0, lambda, mu, rho, wd, ws;
+  int one_frequency;
+} cube_mode;
+
+static cube_mode cube_mode_make(double A, double B, double C, int one) {
+  cube_mode m = {.A = {A, B, C}, .U0 = 5e-4, .rho = 1100.0};
+  const double E = 17e6, nu = 0.3;
+  m.lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  m.mu = E / (2.0 * (1.0 + nu));
+  m.wd = M_PI * sqrt(3.0) / 2.0 * sqrt((m.lambda + 2.0 * m.mu) / m.rho);
+  m.ws = M_PI * sqrt(3.0) / 2.0 * sqrt(m.mu / m.rho);
+  m.one_frequency = one;
+  return m;
+}
+
+static double cube_u(const cube_mode *m, int i, const double X[3], double t) {
+  const double h = M_PI / 2.0, mean = (m->A[0] + m->A[1] + m->A[2]) / 3.0;
+  double f = 1.0;
+  for (int k = 0; k < 3; ++k)
+    f *= k == i ? sin(h * X[k]) : cos(h * X[k]);
+  if (m->one_frequency)
+    return m->U0 * m->A[i] * f * cos(m->wd * t);
+  return m->U0 * f *
+         (mean * cos(m->wd * t) + (m->A[i] - mean) * cos(m->ws * t));
+}
+
+/* d u_i / d X_j by central differences */
+static double cube_du(const cube_mode *m, int i, int j, const double X[3],
+                      double t, double d) {
+  double Xp[3] = {X[0], X[1], X[2]}, Xm[3] = {X[0], X[1], X[2]};
+  Xp[j] += d;
+  Xm[j] -= d;
+  return (cube_u(m, i, Xp, t) - cube_u(m, i, Xm, t)) / (2.0 * d);
+}
+
+/* largest |rho u'' - div sigma| over sample points and times, relative to
+ * |rho u''|, by central differences of step d */
+static double cube_residual(const cube_mode *m) {
+  const double d = 1e-3, dt = 1e-6;
+  double worst = 0.0;
+  for (int s = 0; s < 5; ++s) {
+    const double X[3] = {0.13 + 0.17 * s, 0.71 - 0.11 * s, 0.29 + 0.09 * s};
+    const double t = 0.0011 + 0.0023 * s;
+    for (int i = 0; i < 3; ++i) {
+      const double acc = (cube_u(m, i, X, t + dt) - 2.0 * cube_u(m, i, X, t) +
+                          cube_u(m, i, X, t - dt)) /
+                         (dt * dt);
+      /* div sigma_i = sum_j d/dX_j (mu (u_ij + u_ji) + lambda div u d_ij) */
+      double div = 0.0;
+      for (int j = 0; j < 3; ++j) {
+        double Xp[3] = {X[0], X[1], X[2]}, Xm[3] = {X[0], X[1], X[2]};
+        Xp[j] += d;
+        Xm[j] -= d;
+        double sp =
+            m->mu * (cube_du(m, i, j, Xp, t, d) + cube_du(m, j, i, Xp, t, d));
+        double sm =
+            m->mu * (cube_du(m, i, j, Xm, t, d) + cube_du(m, j, i, Xm, t, d));
+        if (i == j)
+          for (int k = 0; k < 3; ++k) {
+            sp += m->lambda * cube_du(m, k, k, Xp, t, d);
+            sm += m->lambda * cube_du(m, k, k, Xm, t, d);
+          }
+        div += (sp - sm) / (2.0 * d);
+      }
+      worst = fmax(worst,
+                   fabs(m->rho * acc - div) / (m->rho * m->U0 * m->wd * m->wd));
+    }
+  }
+  return worst;
+}
+
+/* the reference's errors when the particles carry this mode's exact fields
+ * at time t */
+static sph_reference_error cube_errors_of(const cube_mode *m, double t) {
+  char path[512], amp[160];
+  snprintf(path, sizeof path, "%s/scenes/swinging_cube.yaml", SPH_SOURCE_DIR);
+  snprintf(amp, sizeof amp,
+           "reference={analytic: swinging_cube, U0: 5.0e-4, A: %.17g, "
+           "B: %.17g, C: %.17g}",
+           m->A[0], m->A[1], m->A[2]);
+  const char *sets[] = {amp, "bodies.0.particles.spacing=0.25"};
+  sph_scene *s;
+  sph_sim *sim;
+  sph_error err;
+  ck_assert_msg(sph_scene_load(&s, path, sets, 2, &err) == SPH_OK, "%s",
+                err.message);
+  ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
+  ck_assert(sim->method->derive(sim, &err) == SPH_OK);
+  sph_particles *ps = sim->ps;
+  const double h = 1e-6;
+  for (size_t a = 0; a < ps->n; ++a) {
+    const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+    double G[9];
+    for (int i = 0; i < 3; ++i) {
+      ps->field[SPH_FIELD_DISPLACEMENT][3 * a + i] = cube_u(m, i, X, t);
+      ps->field[SPH_FIELD_VELOCITY][3 * a + i] =
+          (cube_u(m, i, X, t + h) - cube_u(m, i, X, t - h)) / (2.0 * h);
+      for (int j = 0; j < 3; ++j)
+        G[3 * i + j] = cube_du(m, i, j, X, t, 1e-6);
+    }
+    double *P = ps->field[SPH_FIELD_PK1] + 9 * a;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        P[3 * i + j] = m->mu * (G[3 * i + j] + G[3 * j + i]) +
+                       (i == j) * m->lambda * (G[0] + G[4] + G[8]);
+  }
+  sim->t = t;
+  sph_reference_error e;
+  sph_reference_errors(sim->reference, sim, &e);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+  return e;
+}
+
+START_TEST(cube_any_amplitudes) {
+  const double amps[][3] = {{1, 1, 1}, {1, 1, -2}, {1, 0.5, -1.5}, {1, 0, 0}};
+  for (size_t c = 0; c < sizeof amps / sizeof *amps; ++c) {
+    cube_mode m = cube_mode_make(amps[c][0], amps[c][1], amps[c][2], 0);
+    /* the test's field solves elastodynamics (central differences:
+     * truncation ~ (pi d / 2)^2 ~ 1e-6, round-off ~ eps / dt^2 w^2 ~ 1e-6) */
+    double r = cube_residual(&m);
+    ck_assert_msg(r < 1e-4, "A = (%g %g %g): residual %g", m.A[0], m.A[1],
+                  m.A[2], r);
+    /* the reference agrees with it at a time when the two frequencies have
+     * drifted apart (differences of step 1e-6: errors ~ 1e-9) */
+    sph_reference_error e = cube_errors_of(&m, 0.0123);
+    ck_assert_msg(e.l2_displacement < 1e-7 && e.l2_velocity < 1e-7 &&
+                      e.l2_stress < 1e-7,
+                  "A = (%g %g %g): e_u %g e_v %g e_P %g", m.A[0], m.A[1],
+                  m.A[2], e.l2_displacement, e.l2_velocity, e.l2_stress);
+    /* one frequency for every component solves it only for A = B = C */
+    cube_mode one = cube_mode_make(amps[c][0], amps[c][1], amps[c][2], 1);
+    double r1 = cube_residual(&one);
+    int equal = m.A[0] == m.A[1] && m.A[1] == m.A[2];
+    ck_assert_msg(equal ? r1 < 1e-4 : r1 > 0.1, "one frequency: residual %g",
+                  r1);
+  }
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("reference");
   TCase *tc = tcase_create("reference");
@@ -179,6 +327,7 @@ int main(void) {
   tcase_add_test(tc, period_input_errors);
   tcase_add_test(tc, cube_initial_state);
   tcase_add_test(tc, cube_refused_by_ul_sph);
+  tcase_add_test(tc, cube_any_amplitudes);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }
