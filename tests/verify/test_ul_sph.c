@@ -23,22 +23,30 @@ START_TEST(riemann_is_symmetric_and_limited) {
   double e[3] = {0.6, 0.8, 0}, me[3] = {-0.6, -0.8, 0};
   double vi[3] = {1, -2, 0.5}, vj[3] = {-0.5, 1, 0};
   ul_riemann ij =
-      ul_sph_iact_riemann(e, vi, vj, 1000, 1010, 2e5, -1e5, 50, 60, 1);
+      ul_sph_iact_riemann(e, vi, vj, 1000, 1010, 2e5, -1e5, 50, 60, 1, 1);
   ul_riemann ji =
-      ul_sph_iact_riemann(me, vj, vi, 1010, 1000, -1e5, 2e5, 60, 50, 1);
+      ul_sph_iact_riemann(me, vj, vi, 1010, 1000, -1e5, 2e5, 60, 50, 1, 1);
   /* P* is the same seen from either side: momentum is conserved */
   ck_assert_double_eq_tol(ij.pstar, ji.pstar, 1e-9 * fabs(ij.pstar));
   /* separating pair: no dissipation, P* the impedance-weighted mean */
   double zl = 1000 * 50.0, zr = 1010 * 60.0;
   ul_riemann sep =
-      ul_sph_iact_riemann(e, vj, vi, 1000, 1010, 2e5, -1e5, 50, 60, 0);
+      ul_sph_iact_riemann(e, vj, vi, 1000, 1010, 2e5, -1e5, 50, 60, 0, 1);
   ck_assert_double_eq_tol(sep.pstar, (zl * -1e5 + zr * 2e5) / (zl + zr), 1e-6);
   /* approaching faster than c / 3: beta = 1 */
   double a[3] = {-100, 0, 0}, b[3] = {100, 0, 0}, x[3] = {1, 0, 0};
-  ul_riemann hit = ul_sph_iact_riemann(x, a, b, 1000, 1000, 0, 0, 50, 50, 0);
+  ul_riemann hit = ul_sph_iact_riemann(x, a, b, 1000, 1000, 0, 0, 50, 50, 0, 1);
   ck_assert_double_eq_tol(hit.pstar, 0.5 * 1000 * 50 * 200, 1e-6);
   /* without the pressure term U* is the mean: du = (U_L - U_R) / 2 */
   ck_assert_double_eq_tol(hit.du, 100.0, 1e-12);
+  /* unlimited (dissipation: full): beta = 1 for every pair, so a slowly
+   * separating pair is pulled back by z_L z_R (U_L - U_R) / (z_L + z_R) */
+  ul_riemann full =
+      ul_sph_iact_riemann(e, vj, vi, 1000, 1010, 2e5, -1e5, 50, 60, 0, 0);
+  double jump = sph_vec3_dot(vj, e) * -1.0 + sph_vec3_dot(vi, e);
+  ck_assert(jump < 0.0);
+  ck_assert_double_eq_tol(
+      full.pstar, (zl * -1e5 + zr * 2e5 + zl * zr * jump) / (zl + zr), 1e-6);
 }
 END_TEST
 

@@ -1,9 +1,11 @@
 /* ul-sph: the updated-Lagrangian SPH family of seed 002 (Zhang, Lourenco,
  * Wu, Zhang, Hu 2024, the SPHinXsys elastic dynamics):
  *  - density by the Riemann continuity equation (eq. 11) and pressure force
- *    (eq. 12) with the low-dissipation Riemann solver (eq. 13-16), linear
- *    equation of state p = c0^2 (rho - rho0), c0 = sqrt(E / (3 (1 - 2 nu)
- *    rho0)) (eq. 4-5);
+ *    (eq. 12) with the low-dissipation Riemann solver (eq. 13-15; the
+ *    limiter of eq. 16 with `dissipation: limited`, else beta = 1 on every
+ *    pair as the authors' code, which keeps rebounds from gaining energy),
+ *    linear equation of state p = c0^2 (rho - rho0),
+ *    c0 = sqrt(E / (3 (1 - 2 nu) rho0)) (eq. 4-5);
  *  - shear `original` (SPH-OG): shear stress integrated from the velocity
  *    gradient (eq. 6-8, 18), nested force eq. 17;
  *  - shear `artificial-stress` (SPH-OAS): OG plus the artificial stress of
@@ -162,9 +164,9 @@ static void accelerations(ul_sph *m, double *acc, double *accs) {
       size_t b = (size_t)nl->index[s];
       const double *e = m->e + 3 * s;
       double Vb = m->vol[b];
-      ul_riemann rs =
-          ul_sph_iact_riemann(e, va, m->v + 3 * b, m->rho[a], m->rho[b],
-                              m->p[a], m->p[b], m->c0[a], m->c0[b], 0);
+      ul_riemann rs = ul_sph_iact_riemann(e, va, m->v + 3 * b, m->rho[a],
+                                          m->rho[b], m->p[a], m->p[b], m->c0[a],
+                                          m->c0[b], 0, m->limited);
       if (body[a] != body[b]) { /* bodies push, never pull */
         if (rs.pstar > 0.0)
           ul_sph_iact_pressure(ap, Vb, rs.pstar, m->dW[s], e);
@@ -213,7 +215,7 @@ static void continuity_and_shear(ul_sph *m, double dt) {
       double Vb = m->vol[b];
       ul_riemann rs =
           ul_sph_iact_riemann(e, va, vb, m->rho[a], m->rho[b], m->p[a], m->p[b],
-                              m->c0[a], m->c0[b], pt);
+                              m->c0[a], m->c0[b], pt, m->limited);
       if (body[a] != body[b]) { /* contact: only while it pushes */
         if (rs.pstar > 0.0)
           dr += ul_sph_iact_continuity(Vb, rs.du, m->dW[s]);
@@ -479,8 +481,9 @@ static sph_status check_scene(const sph_scene *s, sph_error *err) {
 
 static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   static const char *const keys[] = {
-      "name",       "shear", "time_stepping",     "cfl", "cfl_advection",
-      "continuity", "zeta",  "artificial_stress", NULL};
+      "name",          "shear",      "time_stepping", "cfl",
+      "cfl_advection", "continuity", "zeta",          "artificial_stress",
+      "dissipation",   NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   const sph_scene *s = sim->scene;
   SPH_TRY(check_scene(s, err));
@@ -502,7 +505,8 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                                        "laplacian", NULL};
   static const char *const stepping[] = {"dual", "single", NULL};
   static const char *const cont[] = {"average", "riemann", NULL};
-  int sh, ts, ct;
+  static const char *const diss[] = {"limited", "full", NULL};
+  int sh, ts, ct, ds;
   SPH_TRY(sph_node_get_choice(opt, "shear", shears, "laplacian", &sh, err));
   /* OG and OAS as the paper ran them: single-criterion (with dual steps
    * OAS blows up on the rings within 1.5 ms) */
@@ -513,6 +517,11 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->shear = (ul_shear)sh;
   m->dual = ts == 0;
   m->pressure_term = ct == 1;
+  /* full: the authors' code (SPHinXsys' dissipative Riemann solver for UL
+   * solids); limited: eq. 16 as printed, which lets ENOG's shear force
+   * (no potential) create energy after a rebound */
+  SPH_TRY(sph_node_get_choice(opt, "dissipation", diss, "full", &ds, err));
+  m->limited = ds == 0;
   SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.4, &m->cfl_ac, err));
   if (!(m->cfl_ac > 0.0 && m->cfl_ac <= 1.0))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,

@@ -22,16 +22,22 @@ typedef struct ul_riemann {
   double pstar; /* P* */
 } ul_riemann;
 
-/* eq. 13-16; `pressure_term` keeps (P_L - P_R) / (z_L + z_R) in U* */
+/* eq. 13-16; `pressure_term` keeps (P_L - P_R) / (z_L + z_R) in U*;
+ * `limited` applies the limiter beta of eq. 16 (dissipation only while the
+ * pair approaches, growing with its Mach number), else beta = 1 for every
+ * pair (the unlimited dissipative solver of the authors' code) */
 static inline ul_riemann
 ul_sph_iact_riemann(const double e[3], const double vi[3], const double vj[3],
                     double rho_i, double rho_j, double p_i, double p_j,
-                    double c_i, double c_j, int pressure_term) {
+                    double c_i, double c_j, int pressure_term, int limited) {
   double uL = -sph_vec3_dot(vi, e), uR = -sph_vec3_dot(vj, e);
   double zL = rho_i * c_i, zR = rho_j * c_j, inv = 1.0 / (zL + zR);
   double jump = uL - uR;
-  double beta = 3.0 * jump * 2.0 / (c_i + c_j);
-  beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
+  double beta = 1.0;
+  if (limited) {
+    beta = 3.0 * jump * 2.0 / (c_i + c_j);
+    beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
+  }
   ul_riemann s;
   s.du = (zR * jump - (pressure_term ? p_i - p_j : 0.0)) * inv;
   s.pstar = (zL * p_j + zR * p_i + beta * zL * zR * jump) * inv;

@@ -18,6 +18,7 @@ typedef struct ul_sph {
   ul_shear shear;
   int dual;          /* dual-criteria stepping (eq. 25-29), else single */
   int pressure_term; /* (P_L - P_R) in U* of the continuity equation */
+  int limited;       /* limiter beta of eq. 16, else beta = 1 (full) */
   double cfl_ad, cfl_ac, zeta;
   double c0_max;              /* largest c0 of the bodies (eq. 26) */
   double as_eps, as_n, as_w0; /* artificial stress: epsilon, n, W(dp) */
