@@ -40,6 +40,9 @@ static void usage(FILE *out) {
           "          [--max-cluster N] [--diff OUT.png]\n"
           "                       compare two images (exit 0 same, 1 "
           "different)\n"
+          "  bench [--quick] [--json FILE] [--threads N]\n"
+          "                       throughput, split and memory of a fixed "
+          "suite\n"
           "  help                 this text\n");
 }
 
@@ -180,6 +183,8 @@ int main(int argc, char **argv) {
     return sph_cmd_study(argc, argv);
   if (!strcmp(cmd, "imgdiff"))
     return sph_cmd_imgdiff(argc, argv);
+  if (!strcmp(cmd, "bench"))
+    return sph_cmd_bench(argc, argv);
   if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
     usage(stdout);
     return SPH_EXIT_OK;

@@ -1,0 +1,504 @@
+/* sph bench: a fixed suite of throughput cases built from the shipped scenes
+ * (DESIGN.md sec. 1), each run in its own child process so that its peak
+ * memory (the child's maximum resident set) is its own, on one thread and
+ * on every core. Prints a table and, with --json FILE, writes the figures.
+ * It times the solver's own steps and timers (those summary.json reports);
+ * nothing here is a test threshold: machines are shared and noisy. */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "app/app_impl.h"
+#include "sph/render.h"
+#include "sph/scene.h"
+#include "sph/sim.h"
+#include "sph/sink.h"
+
+#define BENCH_SCHEMA 1
+#define BENCH_MAX_SETS 8
+#define BENCH_MAX_PARTS 24
+
+/* One case: a shipped scene with overrides, run for a fixed step count;
+ * `frame` also times a .vtp write and a 1280 x 720 frame of the state. */
+typedef struct bench_case {
+  const char *name;
+  const char *scene;
+  const char *sets[BENCH_MAX_SETS];
+  long steps;
+  int frame;
+} bench_case;
+
+#define PLATE30                                                                \
+  "bodies.0.particles.spacing=0.00066666666666666667",                         \
+      "bodies.0.shape.box.min=[-0.0026666666666666667,-0.01]"
+
+static const bench_case full_cases[] = {
+    {"twisting column 11x61x11 tl-jst pF",
+     "twisting_column",
+     {"bodies.0.particles.count=[11,61,11]", "method.fields=pF"},
+     200,
+     0},
+    {"twisting column 11x61x11 tl-jst pFJ",
+     "twisting_column",
+     {"bodies.0.particles.count=[11,61,11]", "method.fields=pFJ"},
+     200,
+     0},
+    {"twisting column 11x61x11 tl-jst pFHJ",
+     "twisting_column",
+     {"bodies.0.particles.count=[11,61,11]", "method.fields=pFHJ"},
+     200,
+     0},
+    {"twisting column 11x61x11 tl-csph",
+     "twisting_column",
+     {"bodies.0.particles.count=[11,61,11]", "method={name: tl-csph}"},
+     400,
+     0},
+    {"2D plate H/dp 10 ul-sph ENOG dual", "oscillating_plate_2d", {0}, 4000, 0},
+    {"2D plate H/dp 30 ul-sph ENOG dual",
+     "oscillating_plate_2d",
+     {PLATE30},
+     1000,
+     0},
+    {"colliding rings dp 0.001 ul-sph ENOG", "colliding_rings", {0}, 1000, 0},
+    {"1M particles tl-jst pF, 3 steps, .vtp, frame",
+     "twisting_column",
+     {"bodies.0.particles.count=[55,330,55]", "method.fields=pF"},
+     3,
+     1},
+};
+
+static const bench_case quick_cases[] = {
+    {"twisting column 5x25x5 tl-jst pF",
+     "twisting_column",
+     {"bodies.0.particles.count=[5,25,5]", "method.fields=pF"},
+     100,
+     0},
+    {"twisting column 5x25x5 tl-jst pFJ",
+     "twisting_column",
+     {"bodies.0.particles.count=[5,25,5]", "method.fields=pFJ"},
+     100,
+     0},
+    {"twisting column 5x25x5 tl-jst pFHJ",
+     "twisting_column",
+     {"bodies.0.particles.count=[5,25,5]", "method.fields=pFHJ"},
+     100,
+     0},
+    {"twisting column 5x25x5 tl-csph",
+     "twisting_column",
+     {"bodies.0.particles.count=[5,25,5]", "method={name: tl-csph}"},
+     200,
+     0},
+    {"2D plate H/dp 10 ul-sph ENOG dual", "oscillating_plate_2d", {0}, 400, 0},
+    {"2D plate H/dp 30 ul-sph ENOG dual",
+     "oscillating_plate_2d",
+     {PLATE30},
+     20,
+     0},
+    {"colliding rings dp 0.002 ul-sph ENOG",
+     "colliding_rings",
+     {"bodies.0.particles.spacing=0.002", "bodies.1.particles.spacing=0.002"},
+     100,
+     0},
+    {"48k particles tl-jst pF, 3 steps, .vtp, frame",
+     "twisting_column",
+     {"bodies.0.particles.count=[20,120,20]", "method.fields=pF"},
+     3,
+     1},
+};
+
+/* what a child measured, sent back through a pipe */
+typedef struct bench_result {
+  int ok;
+  char error[256];
+  long particles, steps;
+  int threads;
+  double setup_seconds, step_seconds, vtp_seconds, frame_seconds;
+  int nparts;
+  char part[BENCH_MAX_PARTS][48];
+  double part_seconds[BENCH_MAX_PARTS];
+  long max_rss_kb; /* filled by the parent */
+} bench_result;
+
+static const char *const outputs_off[] = {
+    "output.vtk=false", "output.png=false", "output.probes=[]", "time.end=1e9",
+    "output.every=1e8"};
+
+/* the frame case keeps the scene's png block and the vtk sink */
+static const char *const outputs_frame[] = {
+    "output.vtk=true", "output.png={width: 1280, height: 720, mp4: false}",
+    "output.probes=[]", "time.end=1e9", "output.every=1e8"};
+
+/* the method's timers and the terms, in that order; with `since`, the
+ * seconds spent after that snapshot (set-up work excluded) */
+static void collect_parts(const sph_sim *sim, bench_result *r,
+                          const bench_result *since) {
+  r->nparts = 0;
+  for (int i = 0; i < sim->ntimers && r->nparts < BENCH_MAX_PARTS; ++i) {
+    snprintf(r->part[r->nparts], sizeof r->part[0], "%s", sim->timers[i].name);
+    r->part_seconds[r->nparts++] = sim->timers[i].seconds;
+  }
+  for (int i = 0; i < sim->nterms && r->nparts < BENCH_MAX_PARTS; ++i) {
+    snprintf(r->part[r->nparts], sizeof r->part[0], "%s",
+             sim->terms[i].ops->name);
+    r->part_seconds[r->nparts++] = sim->terms[i].seconds;
+  }
+  for (int i = 0; since && i < r->nparts && i < since->nparts; ++i)
+    r->part_seconds[i] -= since->part_seconds[i];
+}
+
+static sph_status time_sink(const sph_sink_ops *ops, sph_sim *sim,
+                            const char *dir, double *seconds, sph_error *err) {
+  sph_sink sink = {.ops = ops};
+  sph_status st = sim->method->derive(sim, err);
+  sph_frame fr = {
+      .time = sim->t, .step = sim->steps, .sim = sim, .ps = sim->ps};
+  sim->method->energy(sim, &fr.kinetic, &fr.strain);
+  if (st == SPH_OK)
+    st = ops->open(&sink, sim, dir, err);
+  double t0 = sph_wtime();
+  if (st == SPH_OK)
+    st = ops->write(&sink, &fr, err);
+  if (st == SPH_OK)
+    st = ops->close(&sink, err);
+  *seconds = sph_wtime() - t0;
+  if (ops->destroy)
+    ops->destroy(&sink);
+  return st;
+}
+
+/* the child: load, step, time; fills r */
+static void bench_child(const bench_case *c, int threads, const char *dir,
+                        bench_result *r) {
+  omp_set_num_threads(threads);
+  const char *sets[BENCH_MAX_SETS + 8];
+  size_t n = 0;
+  for (int i = 0; i < BENCH_MAX_SETS && c->sets[i]; ++i)
+    sets[n++] = c->sets[i];
+  const char *const *extra = c->frame ? outputs_frame : outputs_off;
+  size_t nextra = c->frame ? sizeof outputs_frame / sizeof *outputs_frame
+                           : sizeof outputs_off / sizeof *outputs_off;
+  for (size_t i = 0; i < nextra; ++i)
+    sets[n++] = extra[i];
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s.yaml", sph_app_scenes_dir(), c->scene);
+  sph_scene *scene = NULL;
+  sph_sim *sim = NULL;
+  sph_error err;
+  sph_error_clear(&err);
+  double t0 = sph_wtime();
+  sph_status st = sph_scene_load(&scene, path, sets, n, &err);
+  if (st == SPH_OK)
+    st = sph_sim_create(&sim, scene, &err);
+  r->setup_seconds = sph_wtime() - t0;
+  if (st == SPH_OK) {
+    r->particles = (long)sim->ps->n;
+    r->threads = sim->threads;
+    bench_result *before = calloc(1, sizeof *before);
+    if (before)
+      collect_parts(sim, before, NULL);
+    t0 = sph_wtime();
+    for (long k = 0; k < c->steps && st == SPH_OK; ++k)
+      st = sph_sim_step(sim, scene->t_end - sim->t, &err);
+    r->step_seconds = sph_wtime() - t0;
+    r->steps = (long)sim->steps;
+    collect_parts(sim, r, before);
+    free(before);
+  }
+  if (st == SPH_OK && c->frame)
+    st = time_sink(&sph_vtk_sink_ops, sim, dir, &r->vtp_seconds, &err);
+  if (st == SPH_OK && c->frame)
+    st = time_sink(&sph_png_sink_sync_ops, sim, dir, &r->frame_seconds, &err);
+  r->ok = st == SPH_OK;
+  if (!r->ok)
+    sph_error_format(&err, r->error, sizeof r->error);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(scene);
+}
+
+/* runs one case in a child process; returns 0, or -1 when it could not */
+static int bench_run(const bench_case *c, int threads, const char *dir,
+                     bench_result *r) {
+  memset(r, 0, sizeof *r);
+  int fd[2];
+  if (pipe(fd) != 0)
+    return -1;
+  fflush(NULL);
+  pid_t pid = fork();
+  if (pid < 0) {
+    close(fd[0]);
+    close(fd[1]);
+    return -1;
+  }
+  if (pid == 0) {
+    close(fd[0]);
+    bench_result mine;
+    memset(&mine, 0, sizeof mine);
+    bench_child(c, threads, dir, &mine);
+    ssize_t w = write(fd[1], &mine, sizeof mine);
+    _exit(w == (ssize_t)sizeof mine ? 0 : 1);
+  }
+  close(fd[1]);
+  size_t got = 0;
+  while (got < sizeof *r) {
+    ssize_t k = read(fd[0], (char *)r + got, sizeof *r - got);
+    if (k <= 0)
+      break;
+    got += (size_t)k;
+  }
+  close(fd[0]);
+  int status = 0;
+  struct rusage ru;
+  if (wait4(pid, &status, 0, &ru) < 0)
+    return -1;
+  if (got != sizeof *r) {
+    memset(r, 0, sizeof *r);
+    snprintf(r->error, sizeof r->error, "the case's process ended (%s %d)",
+             WIFSIGNALED(status) ? "signal" : "status",
+             WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status));
+  }
+  r->max_rss_kb = ru.ru_maxrss;
+  return 0;
+}
+
+static double per_thread_rate(const bench_result *r) {
+  return r->step_seconds > 0.0 ? (double)r->particles * (double)r->steps /
+                                     r->step_seconds / r->threads
+                               : 0.0;
+}
+
+static void print_row(const bench_case *c, const bench_result *r,
+                      long baseline_kb) {
+  if (!r->ok) {
+    printf("  %-46s %2d thr  FAILED: %s\n", c->name, r->threads, r->error);
+    return;
+  }
+  double bytes = r->particles > 0 ? (double)(r->max_rss_kb - baseline_kb) *
+                                        1024.0 / (double)r->particles
+                                  : 0.0;
+  char per[32] = "";
+  /* below 10,000 particles the baseline's noise outweighs the state */
+  if (r->particles >= 10000)
+    snprintf(per, sizeof per, " (%.2f kB/p)", bytes / 1024.0);
+  printf("  %-46s %2d thr %9ld p %6ld st %8.3f s %7.3f M p-st/s/thr  "
+         "setup %.2f s  peak %.0f MB%s",
+         c->name, r->threads, r->particles, r->steps, r->step_seconds,
+         per_thread_rate(r) / 1e6, r->setup_seconds,
+         (double)r->max_rss_kb / 1024.0, per);
+  if (c->frame)
+    printf("  .vtp %.3f s  frame %.3f s", r->vtp_seconds, r->frame_seconds);
+  printf("\n");
+  /* the step's split, largest first */
+  int order[BENCH_MAX_PARTS];
+  for (int i = 0; i < r->nparts; ++i)
+    order[i] = i;
+  for (int i = 1; i < r->nparts; ++i)
+    for (int j = i;
+         j > 0 && r->part_seconds[order[j]] > r->part_seconds[order[j - 1]];
+         --j) {
+      int t = order[j];
+      order[j] = order[j - 1];
+      order[j - 1] = t;
+    }
+  double covered = 0.0;
+  printf("      split:");
+  for (int i = 0; i < r->nparts; ++i) {
+    const double sec = r->part_seconds[order[i]];
+    covered += sec;
+    if (r->step_seconds > 0.0 && sec >= 0.01 * r->step_seconds)
+      printf(" %s %.0f %%", r->part[order[i]], 100.0 * sec / r->step_seconds);
+  }
+  if (r->step_seconds > 0.0)
+    printf("; timed %.0f %% of the steps\n", 100.0 * covered / r->step_seconds);
+  else
+    printf("\n");
+}
+
+static void json_str(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s)
+    if (*s == '"' || *s == '\\')
+      fprintf(f, "\\%c", *s);
+    else if ((unsigned char)*s < 0x20)
+      fprintf(f, "\\u%04x", (unsigned char)*s);
+    else
+      fputc(*s, f);
+  fputc('"', f);
+}
+
+static void cpu_model(char *out, size_t len) {
+  snprintf(out, len, "unknown");
+  FILE *f = fopen("/proc/cpuinfo", "r");
+  char line[512];
+  while (f && fgets(line, sizeof line, f))
+    if (!strncmp(line, "model name", 10)) {
+      const char *v = strchr(line, ':');
+      if (v) {
+        v += 1 + strspn(v + 1, " \t");
+        snprintf(out, len, "%.*s", (int)strcspn(v, "\n"), v);
+      }
+      break;
+    }
+  if (f)
+    fclose(f);
+}
+
+static int write_json(const char *path, const bench_case *cases, int ncases,
+                      const bench_result *res, int nthr, int quick, long cores,
+                      long baseline_kb) {
+  char tmp[1100];
+  snprintf(tmp, sizeof tmp, "%s.part", path);
+  FILE *f = fopen(tmp, "w");
+  if (!f)
+    return -1;
+  char cpu[256];
+  cpu_model(cpu, sizeof cpu);
+  fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
+          BENCH_SCHEMA, quick ? "quick" : "full");
+  fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
+  json_str(f, cpu);
+  fprintf(f, "},\n  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
+          baseline_kb / 1024.0);
+  for (int c = 0; c < ncases; ++c)
+    for (int t = 0; t < nthr; ++t) {
+      const bench_result *r = &res[c * nthr + t];
+      fprintf(f, "%s\n    {\"name\": ", c || t ? "," : "");
+      json_str(f, cases[c].name);
+      fprintf(f, ", \"ok\": %s", r->ok ? "true" : "false");
+      if (!r->ok) {
+        fprintf(f, ", \"error\": ");
+        json_str(f, r->error);
+        fprintf(f, "}");
+        continue;
+      }
+      fprintf(f,
+              ", \"threads\": %d, \"particles\": %ld, \"steps\": %ld, "
+              "\"setup_seconds\": %.6g, \"step_seconds\": %.6g, "
+              "\"particle_steps_per_second_per_thread\": %.6g, "
+              "\"peak_rss_mb\": %.3f, \"bytes_per_particle\": %.6g",
+              r->threads, r->particles, r->steps, r->setup_seconds,
+              r->step_seconds, per_thread_rate(r), r->max_rss_kb / 1024.0,
+              (double)(r->max_rss_kb - baseline_kb) * 1024.0 /
+                  (double)r->particles);
+      if (cases[c].frame)
+        fprintf(f, ", \"vtp_seconds\": %.6g, \"frame_seconds\": %.6g",
+                r->vtp_seconds, r->frame_seconds);
+      fprintf(f, ", \"parts\": {");
+      for (int i = 0; i < r->nparts; ++i) {
+        fprintf(f, "%s", i ? ", " : "");
+        json_str(f, r->part[i]);
+        fprintf(f, ": %.6g", r->part_seconds[i]);
+      }
+      fprintf(f, "}}");
+    }
+  fprintf(f, "\n  ]\n}\n");
+  int bad = ferror(f) != 0;
+  bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
+  bad |= fclose(f) != 0;
+  if (bad || rename(tmp, path) != 0) {
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
+/* empties and removes the suite's own temporary folder (one level of
+ * sub-folders: frames/) */
+static void remove_dir_files(const char *dir) {
+  char sub[1200], path[1500];
+  snprintf(sub, sizeof sub, "%s/frames", dir);
+  const char *const dirs[] = {sub, dir};
+  for (int i = 0; i < 2; ++i) {
+    DIR *d = opendir(dirs[i]);
+    struct dirent *e;
+    while (d && (e = readdir(d)))
+      if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+        snprintf(path, sizeof path, "%s/%s", dirs[i], e->d_name);
+        remove(path);
+      }
+    if (d)
+      closedir(d);
+    rmdir(dirs[i]);
+  }
+}
+
+int sph_cmd_bench(int argc, char **argv) {
+  int quick = 0, threads = 0;
+  const char *json = NULL;
+  for (int i = 2; i < argc; ++i) {
+    if (!strcmp(argv[i], "--quick"))
+      quick = 1;
+    else if (!strcmp(argv[i], "--json") && i + 1 < argc)
+      json = argv[++i];
+    else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
+      char *end;
+      long n = strtol(argv[++i], &end, 10);
+      if (*end || n < 1 || n > 1024) {
+        fprintf(stderr, "sph bench: --threads takes a count from 1 to 1024\n");
+        return SPH_EXIT_USAGE;
+      }
+      threads = (int)n;
+    } else {
+      fprintf(stderr,
+              "sph bench: unknown option %s\nusage: sph bench "
+              "[--quick] [--json FILE] [--threads N]\n",
+              argv[i]);
+      return SPH_EXIT_USAGE;
+    }
+  }
+  const bench_case *cases = quick ? quick_cases : full_cases;
+  int ncases = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
+                     : (int)(sizeof full_cases / sizeof *full_cases);
+  long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  int thr[2] = {1, threads ? threads : (int)(cores > 0 ? cores : 1)};
+  int nthr = thr[1] == 1 ? 1 : 2;
+  char dir[] = "/tmp/sph_bench_XXXXXX";
+  if (!mkdtemp(dir)) {
+    fprintf(stderr, "sph bench: cannot create a temporary folder: %s\n",
+            strerror(errno));
+    return 3;
+  }
+  /* the resident set of a process that sets up the smallest scene (the
+   * default column, 625 particles) and takes no step: subtracted before
+   * dividing by a case's particle count */
+  bench_case none = {"baseline", "twisting_column", {0}, 0, 0};
+  bench_result base;
+  bench_run(&none, 1, dir, &base);
+  long baseline_kb = base.max_rss_kb;
+  printf("sph bench (%s suite): %ld cores, threads %d%s%d; baseline "
+         "resident set %.0f MB\n",
+         quick ? "quick" : "full", cores, thr[0], nthr > 1 ? " and " : "",
+         nthr > 1 ? thr[1] : 0, baseline_kb / 1024.0);
+  bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
+  if (!res) {
+    remove_dir_files(dir);
+    return 3;
+  }
+  int failed = 0;
+  for (int c = 0; c < ncases; ++c)
+    for (int t = 0; t < nthr; ++t) {
+      bench_result *r = &res[c * nthr + t];
+      if (bench_run(&cases[c], thr[t], dir, r) != 0)
+        snprintf(r->error, sizeof r->error, "could not start: %s",
+                 strerror(errno));
+      if (!r->threads)
+        r->threads = thr[t];
+      failed |= !r->ok;
+      print_row(&cases[c], r, baseline_kb);
+    }
+  int rc = failed ? SPH_EXIT_FAIL : SPH_EXIT_OK;
+  if (json && write_json(json, cases, ncases, res, nthr, quick, cores,
+                         baseline_kb) != 0) {
+    fprintf(stderr, "sph bench: cannot write %s\n", json);
+    rc = 3;
+  }
+  free(res);
+  remove_dir_files(dir);
+  return rc;
+}

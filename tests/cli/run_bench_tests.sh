@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# sph bench: the quick suite runs every case on 1 thread and on every core
+# and writes its JSON (schema, machine, per case the figures); every figure
+# is finite and positive. No timing thresholds: machines are shared.
+set -u
+sph=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+
+if "$sph" bench --quick --json "$work/bench.json" >"$work/out" 2>&1; then
+  ok
+else
+  bad "sph bench --quick exited $?: $(cat "$work/out")"
+fi
+cat "$work/out"
+if python3 - "$work/bench.json" <<'PY'; then
+import json, math, sys
+b = json.load(open(sys.argv[1]))
+assert b["schema_version"] == 1 and b["suite"] == "quick", b
+assert b["machine"]["cores"] >= 1 and b["machine"]["cpu"], b["machine"]
+cases = b["cases"]
+names = {c["name"] for c in cases}
+assert len(names) == 8, names
+threads = {c["threads"] for c in cases}
+assert 1 in threads, threads
+for c in cases:
+    assert c["ok"], c
+    for k in ("particles", "steps", "step_seconds", "setup_seconds",
+              "particle_steps_per_second_per_thread", "peak_rss_mb"):
+        assert isinstance(c[k], (int, float)) and math.isfinite(c[k]) \
+            and c[k] > 0, (c["name"], k, c[k])
+    assert c["parts"] and all(math.isfinite(v) and v >= 0
+                              for v in c["parts"].values()), c
+    if "vtp_seconds" in c:
+        assert c["vtp_seconds"] > 0 and c["frame_seconds"] > 0, c
+assert any("vtp_seconds" in c for c in cases)
+PY
+  ok
+else
+  bad "bench.json"
+fi
+"$sph" bench --bogus >/dev/null 2>&1
+[ $? -eq 2 ] && ok || bad "an unknown option: exit not 2"
+ls /tmp/sph_bench_* >/dev/null 2>&1 && bad "temporary folder left" || ok
+echo "$pass passed, $fail failed"
+[ $fail -eq 0 ]
