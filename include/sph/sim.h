@@ -127,6 +127,7 @@ struct sph_sim {
   int nterms;
   sph_timer timers[SPH_MAX_TIMERS];
   int ntimers;
+  int timer_stable_dt; /* the method's stable_dt, timed by sph_sim_step */
   int threads;
   const sph_mirror *mirror;        /* NULL without symmetry planes */
   struct sph_reference *reference; /* the scene's reference, or NULL */

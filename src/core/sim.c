@@ -57,6 +57,9 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)
     st = method->setup(sim, scene->method, err);
+  /* the time step rule (a wave speed per particle) is work of every step */
+  if (st == SPH_OK)
+    sim->timer_stable_dt = sph_sim_add_timer(sim, "stable_dt");
   if (st != SPH_OK) {
     sph_sim_destroy(sim);
     return st;
@@ -79,7 +82,10 @@ void sph_sim_destroy(sph_sim *sim) {
 }
 
 sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
+  double t0 = sph_wtime();
   double dt = sim->method->stable_dt(sim);
+  sim->timers[sim->timer_stable_dt].seconds += sph_wtime() - t0;
+  sim->timers[sim->timer_stable_dt].calls++;
   if (!(dt > 0.0) || !isfinite(dt))
     return sph_error_set(err, SPH_ERR_NUMERIC,
                          "stable time step %g at t = %g is not positive", dt,
