@@ -4,12 +4,7 @@
 # is finite and positive. No timing thresholds: machines are shared.
 set -u
 sph=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+. "$(dirname "$0")/harness.sh"
 
 if "$sph" bench --quick --json "$work/bench.json" >"$work/out" 2>&1; then
   ok

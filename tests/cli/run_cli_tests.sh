@@ -7,12 +7,7 @@ set -u
 sph=$1
 src=$2
 here=$(cd "$(dirname "$0")" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+. "$(dirname "$0")/harness.sh"
 
 for f in "$here"/bad/*.yaml; do
   name=$(basename "$f" .yaml)

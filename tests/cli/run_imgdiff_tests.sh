@@ -7,12 +7,7 @@
 set -u
 sph=$1
 make_pngs=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+. "$(dirname "$0")/harness.sh"
 
 "$make_pngs" "$work" || { echo "FAIL: make_test_pngs"; exit 1; }
 

@@ -8,12 +8,7 @@
 set -u
 sph=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+. "$(dirname "$0")/harness.sh"
 check() { if eval "$2"; then ok; else bad "$1"; fi; }
 scene=$src/scenes/swinging_cube.yaml
 short=(--set time.end=0.002 --threads 1)

@@ -122,18 +122,25 @@ END_TEST
 
 /* the swinging cube at t = 0 with `method`: x = X + u0 and F = I + grad u0
  * whether the method carries F or derives it */
-static void cube_starts_deformed(const char *method) {
-  char path[512], set[128];
+/* the swinging cube at spacing 0.25 with one override, derived at t = 0 */
+static sph_sim *load_cube(const char *set, sph_scene **s) {
+  char path[512];
   snprintf(path, sizeof path, "%s/scenes/swinging_cube.yaml", SPH_SOURCE_DIR);
-  snprintf(set, sizeof set, "method=%s", method);
   const char *sets[] = {set, "bodies.0.particles.spacing=0.25"};
-  sph_scene *s;
   sph_sim *sim;
   sph_error err;
-  ck_assert_msg(sph_scene_load(&s, path, sets, 2, &err) == SPH_OK, "%s",
+  ck_assert_msg(sph_scene_load(s, path, sets, 2, &err) == SPH_OK, "%s",
                 err.message);
-  ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
+  ck_assert_msg(sph_sim_create(&sim, *s, &err) == SPH_OK, "%s", err.message);
   ck_assert(sim->method->derive(sim, &err) == SPH_OK);
+  return sim;
+}
+
+static void cube_starts_deformed(const char *method) {
+  char set[128];
+  snprintf(set, sizeof set, "method=%s", method);
+  sph_scene *s;
+  sph_sim *sim = load_cube(set, &s);
   sph_reference_error e;
   sph_reference_errors(sim->reference, sim, &e);
   /* u = U0 f(X) to the round-off of x - X (eps |X| / U0 ~ 4e-13), v = 0;
@@ -252,20 +259,13 @@ static double cube_residual(const cube_mode *m) {
 /* the reference's errors when the particles carry this mode's exact fields
  * at time t */
 static sph_reference_error cube_errors_of(const cube_mode *m, double t) {
-  char path[512], amp[160];
-  snprintf(path, sizeof path, "%s/scenes/swinging_cube.yaml", SPH_SOURCE_DIR);
+  char amp[160];
   snprintf(amp, sizeof amp,
            "reference={analytic: swinging_cube, U0: 5.0e-4, A: %.17g, "
            "B: %.17g, C: %.17g}",
            m->A[0], m->A[1], m->A[2]);
-  const char *sets[] = {amp, "bodies.0.particles.spacing=0.25"};
   sph_scene *s;
-  sph_sim *sim;
-  sph_error err;
-  ck_assert_msg(sph_scene_load(&s, path, sets, 2, &err) == SPH_OK, "%s",
-                err.message);
-  ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
-  ck_assert(sim->method->derive(sim, &err) == SPH_OK);
+  sph_sim *sim = load_cube(amp, &s);
   sph_particles *ps = sim->ps;
   const double h = 1e-6;
   for (size_t a = 0; a < ps->n; ++a) {
