@@ -26,6 +26,10 @@ typedef struct sph_material_ops {
                  double J, double P[9]);
   double (*energy)(const sph_material *m, const double F[9], const double H[9],
                    double J);
+  /* acoustic tensors Q_ik = dP_id / dF_kd of P(F, cof F, det F) for the
+   * material directions e_d, d = 0, 1, 2, at Q + 9 d (may be NULL: finite
+   * differences of `stress`) */
+  void (*acoustic)(const sph_material *m, const double F[9], double Q[27]);
 } sph_material_ops;
 
 struct sph_material {
@@ -65,6 +69,13 @@ const char *const *sph_material_models(void);
 
 /* p-wave speed in the reference state: sqrt((lambda + 2 mu) / rho0). */
 double sph_material_wave_speed(const sph_material *m);
+
+/* The acoustic tensors of the material directions e_0, e_1, e_2 at F (with
+ * H = cof F, J = det F), symmetrised, at Q + 9 d: rho0 c^2 are their
+ * eigenvalues. Analytic where the model gives it, else forward finite
+ * differences of the stress. */
+void sph_material_acoustic_tensors(const sph_material *m, const double F[9],
+                                   double Q[27]);
 
 static inline void sph_material_stress(const sph_material *m, const double F[9],
                                        const double H[9], double J,

@@ -1,6 +1,8 @@
 /* Linear elastic material, small strain (the cable of seed 000 sec. 8.1):
  * eps = sym(F) - I, P = lambda tr(eps) I + 2 mu eps,
- * W = lambda/2 tr(eps)^2 + mu eps:eps. Not objective, by design. */
+ * W = lambda/2 tr(eps)^2 + mu eps:eps. Not objective, by design.
+ * Acoustic tensor for direction e_d: Q_ik = mu d_ik + (lambda + mu) d_id d_kd,
+ * whatever F. */
 #include "materials/material_impl.h"
 #include "sph/tensor.h"
 
@@ -30,9 +32,19 @@ static double linear_elastic_energy(const sph_material *m, const double F[9],
   return 0.5 * m->lambda * tr * tr + m->mu * sph_mat3_ddot(eps, eps);
 }
 
+static void linear_elastic_acoustic(const sph_material *m, const double F[9],
+                                    double Q[27]) {
+  for (int d = 0; d < 3; ++d)
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
+        Q[9 * d + 3 * i + k] =
+            (i == k) * m->mu + (i == d && k == d) * (m->lambda + m->mu);
+}
+
 const sph_material_ops sph_linear_elastic_ops = {
     .name = "linear-elastic",
     .reference = "small-strain Hooke law (seed 000 sec. 8.1 cable)",
     .stress = linear_elastic_stress,
     .energy = linear_elastic_energy,
+    .acoustic = linear_elastic_acoustic,
 };

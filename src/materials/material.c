@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "materials/material_impl.h"
+#include "sph/tensor.h"
 
 static const sph_material_ops *const models[] = {
     &sph_linear_elastic_ops,
@@ -83,4 +84,32 @@ sph_status sph_material_create(sph_material *m, const sph_material_params *p,
 
 double sph_material_wave_speed(const sph_material *m) {
   return sqrt((m->lambda + 2.0 * m->mu) / m->density);
+}
+
+void sph_material_acoustic_tensors(const sph_material *m, const double F[9],
+                                   double Q[27]) {
+  if (m->ops->acoustic) {
+    m->ops->acoustic(m, F, Q);
+    return;
+  }
+  /* forward differences of P_id in F_kd, step 1e-7 of |F| */
+  double H[9], P0[9];
+  sph_mat3_cofactor(F, H);
+  sph_material_stress(m, F, H, sph_mat3_det(F), P0);
+  double e = 1e-7 * sqrt(sph_mat3_ddot(F, F) / 3.0);
+  for (int d = 0; d < 3; ++d) {
+    double *Qd = Q + 9 * d;
+    for (int k = 0; k < 3; ++k) {
+      double Fp[9], Hp[9], Pp[9];
+      memcpy(Fp, F, sizeof Fp);
+      Fp[3 * k + d] += e;
+      sph_mat3_cofactor(Fp, Hp);
+      sph_material_stress(m, Fp, Hp, sph_mat3_det(Fp), Pp);
+      for (int i = 0; i < 3; ++i)
+        Qd[3 * i + k] = (Pp[3 * i + d] - P0[3 * i + d]) / e;
+    }
+    for (int i = 0; i < 3; ++i) /* symmetric part */
+      for (int k = i + 1; k < 3; ++k)
+        Qd[3 * i + k] = Qd[3 * k + i] = 0.5 * (Qd[3 * i + k] + Qd[3 * k + i]);
+  }
 }

@@ -455,25 +455,10 @@ double tl_max_wave_speed(const tl_reference *ref, const double *F) {
   for (long a = 0; a < n; ++a) {
     const double *Fa = F + 9 * a;
     const sph_material *m = ref->mat[a];
-    double H[9], P0[9];
-    sph_mat3_cofactor(Fa, H);
-    sph_material_stress(m, Fa, H, sph_mat3_det(Fa), P0);
-    double e = 1e-7 * sqrt(sph_mat3_ddot(Fa, Fa) / 3.0);
+    double Q[27];
+    sph_material_acoustic_tensors(m, Fa, Q);
     for (int d = 0; d < 3; ++d) {
-      double Q[9];
-      for (int k = 0; k < 3; ++k) {
-        double Fp[9], Hp[9], Pp[9];
-        memcpy(Fp, Fa, sizeof Fp);
-        Fp[3 * k + d] += e;
-        sph_mat3_cofactor(Fp, Hp);
-        sph_material_stress(m, Fp, Hp, sph_mat3_det(Fp), Pp);
-        for (int i = 0; i < 3; ++i)
-          Q[3 * i + k] = (Pp[3 * i + d] - P0[3 * i + d]) / e;
-      }
-      for (int i = 0; i < 3; ++i) /* symmetric part */
-        for (int k = i + 1; k < 3; ++k)
-          Q[3 * i + k] = Q[3 * k + i] = 0.5 * (Q[3 * i + k] + Q[3 * k + i]);
-      double c2 = sym3_max_eigenvalue(Q) / m->density;
+      double c2 = sym3_max_eigenvalue(Q + 9 * d) / m->density;
       c2max = c2 > c2max ? c2 : c2max;
     }
   }

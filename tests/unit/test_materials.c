@@ -107,6 +107,49 @@ START_TEST(stress_is_energy_derivative) {
 }
 END_TEST
 
+/* the analytic acoustic tensors against central differences of the stress
+ * (step 1e-6: truncation ~ e^2 P''' and round-off ~ eps P / e, ~1e-8 of
+ * kappa); the models without one fall back to forward differences, checked
+ * the same way (their step 1e-7: ~1e-6 of kappa) */
+START_TEST(acoustic_tensor_is_stress_derivative) {
+  rng = 17;
+  for (const char *const *name = sph_material_models(); *name; ++name) {
+    sph_material m = make(*name, 0.45);
+    double worst = 0.0;
+    for (int trial = 0; trial < 20; ++trial) {
+      double F[9], Q[27];
+      random_F(F, trial < 10 ? 0.05 : 0.35);
+      sph_material_acoustic_tensors(&m, F, Q);
+      for (int d = 0; d < 3; ++d)
+        for (int k = 0; k < 3; ++k) {
+          double e = 1e-6, Fp[9], Fm[9], Pp[9], Pm[9];
+          memcpy(Fp, F, sizeof Fp);
+          memcpy(Fm, F, sizeof Fm);
+          Fp[3 * k + d] += e;
+          Fm[3 * k + d] -= e;
+          consistent_stress(&m, Fp, Pp);
+          consistent_stress(&m, Fm, Pm);
+          for (int i = 0; i < 3; ++i) {
+            /* the symmetric part, as the tensors are returned */
+            double fd = (Pp[3 * i + d] - Pm[3 * i + d]) / (2 * e);
+            double Fq[9], Fr[9], Pq[9], Pr[9];
+            memcpy(Fq, F, sizeof Fq);
+            memcpy(Fr, F, sizeof Fr);
+            Fq[3 * i + d] += e;
+            Fr[3 * i + d] -= e;
+            consistent_stress(&m, Fq, Pq);
+            consistent_stress(&m, Fr, Pr);
+            fd = 0.5 * (fd + (Pq[3 * k + d] - Pr[3 * k + d]) / (2 * e));
+            double dev = fabs(Q[9 * d + 3 * i + k] - fd) / m.kappa;
+            worst = dev > worst ? dev : worst;
+          }
+        }
+    }
+    ck_assert_msg(worst < 1e-5, "%s: |Q - dP/dF| / kappa = %g", *name, worst);
+  }
+}
+END_TEST
+
 START_TEST(mooney_rivlin_conjugates) {
   /* with independent H and J: P = dW/dF + dW/dH x F + dW/dJ H */
   rng = 5;
@@ -270,6 +313,7 @@ int main(void) {
   tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
   tcase_add_test(tc, zero_stress_at_identity);
   tcase_add_test(tc, stress_is_energy_derivative);
+  tcase_add_test(tc, acoustic_tensor_is_stress_derivative);
   tcase_add_test(tc, mooney_rivlin_conjugates);
   tcase_add_test(tc, objectivity);
   tcase_add_test(tc, energy_positive_and_small_strain_agreement);
