@@ -58,7 +58,8 @@ typedef struct sph_cloud {
  * at itself (zero for UNCORRECTED and CORRECTED; nonzero for CORRECTED_W0
  * and W1, where sum_b V_b f_b grad W~1_b(x_a) over b including a reproduces
  * linear gradients), and L[9*a] the correction matrices used (identity for
- * UNCORRECTED and W1). */
+ * UNCORRECTED and W1). `grad` may be NULL (not for W1) when only L is
+ * wanted. */
 sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
                                    double *grad, double *grad_self, double *L,
                                    sph_error *err);

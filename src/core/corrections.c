@@ -205,6 +205,8 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
   if ((int)kind < SPH_GRAD_UNCORRECTED || kind > SPH_GRAD_W1)
     return sph_error_set(err, SPH_ERR_ARG, "unknown gradient kind %d",
                          (int)kind);
+  if (!grad && kind == SPH_GRAD_W1)
+    return sph_error_set(err, SPH_ERR_ARG, "W~1 gradients need slots");
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double La[9], gs[3] = {0, 0, 0};
@@ -254,7 +256,8 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
           for (int k = 0; k < 3; ++k)
             g[k] = (g[k] - Wb * gam[k]) / S;
         }
-        memcpy(grad + 3 * s, g, sizeof g);
+        if (grad)
+          memcpy(grad + 3 * s, g, sizeof g);
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j)
             M[3 * i + j] -= c->volume[b] * g[i] * rab[j];
@@ -262,12 +265,13 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
       if (kind != SPH_GRAD_UNCORRECTED) {
         if (invert_block(M, dim, rmin, La) < rmin) {
           mark_bad(&bad, a);
-          clear_slots(nl, (size_t)a, 3, grad);
+          if (grad)
+            clear_slots(nl, (size_t)a, 3, grad);
           if (grad_self)
             memset(grad_self + 3 * a, 0, 3 * sizeof *grad_self);
           continue;
         }
-        for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s)
+        for (size_t s = nl->offset[a]; grad && s < nl->offset[a + 1]; ++s)
           sph_mat3_vec(La, grad + 3 * s, grad + 3 * s);
         sph_mat3_vec(La, gs, gs);
       }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "methods/tl_common_impl.h"
+#include "methods/tl_iact.h"
 #include "sph/corrections.h"
 #include "sph/tensor.h"
 
@@ -198,11 +199,12 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
 /* ---- reference configuration
  * -------------------------------------------------- */
 
-/* slot of (b -> a) for every slot (a -> b): binary search in b's list */
-static sph_status reverse_slots(tl_reference *ref, sph_error *err) {
+/* binary search for a in b's list */
+sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **out,
+                                      sph_error *err) {
   const sph_neighbors *nl = ref->nl;
-  ref->rev = malloc((nl->count ? nl->count : 1) * sizeof *ref->rev);
-  if (!ref->rev)
+  size_t *rev = malloc((nl->count ? nl->count : 1) * sizeof *rev);
+  if (!rev)
     return sph_error_set(err, SPH_ERR_NOMEM, "reverse slots");
   long n = (long)nl->n, missing = 0;
 #pragma omp parallel for schedule(static) reduction(+ : missing)
@@ -218,15 +220,64 @@ static sph_status reverse_slots(tl_reference *ref, sph_error *err) {
           hi = mid;
       }
       if (lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a)
-        ref->rev[k] = lo;
+        rev[k] = lo;
       else
         ++missing;
     }
-  if (missing)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "neighbour lists are not "
-                         "symmetric");
+  if (missing) {
+    free(rev);
+    return sph_error_set(err, SPH_ERR_ARG, "neighbour lists are not symmetric");
+  }
+  *out = rev;
   return SPH_OK;
+}
+
+/* w_ab = V_b W'(r) / r per slot and s_a = sum_b w_ab r_ab */
+static void pair_weights(tl_reference *ref, const sph_kernel *kernel) {
+  const sph_neighbors *nl = ref->nl;
+  long ne = (long)ref->n_ext;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    double s[3] = {0, 0, 0};
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3];
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      double d = sqrt(sph_vec3_dot(r, r));
+      ref->w[k] = d > 0.0 ? ref->V[b] * sph_kernel_dwdr(kernel, d) / d : 0.0;
+      for (int c = 0; c < 3; ++c)
+        s[c] += ref->w[k] * r[c];
+    }
+    if (a < (long)ref->n)
+      memcpy(ref->s + 3 * a, s, sizeof s);
+  }
+}
+
+void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,
+                           double g[3]) {
+  size_t b = (size_t)ref->nl->index[k];
+  double r[3];
+  tl_iact_pair_vector(ref->X, a, b, r);
+  for (int c = 0; c < 3; ++c)
+    r[c] *= ref->w[k] / ref->V[b];
+  sph_mat3_vec(ref->L + 9 * a, r, g);
+}
+
+void tl_conservative_force(const tl_reference *ref, double *dp) {
+  const sph_neighbors *nl = ref->nl;
+  long n = (long)ref->n;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double f[3];
+    sph_mat3_vec(ref->Q + 9 * a, ref->s + 3 * a, f);
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3];
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      tl_iact_force(f, ref->w[k], ref->Q + 9 * b, r);
+    }
+    memcpy(dp + 3 * a, f, sizeof f);
+  }
 }
 
 sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
@@ -310,7 +361,6 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
                               sim->kernel.support, ref->body,
                               SPH_PAIRS_SAME_BODY, err));
-  SPH_TRY(reverse_slots(ref, err));
   int64_t *id = malloc(ne * sizeof *id);
   if (!id)
     return sph_error_set(err, SPH_ERR_NOMEM, "ids");
@@ -323,11 +373,20 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                      .id = id,
                      .nl = ref->nl,
                      .kernel = &sim->kernel};
-  ref->grad = calloc(3 * ref->nl->count + 3, sizeof *ref->grad);
-  sph_status st = ref->grad
-                      ? sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED,
-                                                ref->grad, NULL, NULL, err)
-                      : sph_error_set(err, SPH_ERR_NOMEM, "gradients");
+  ref->w = malloc((ref->nl->count + 1) * sizeof *ref->w);
+  ref->s = calloc(3 * n + 3, sizeof *ref->s);
+  sph_status st = SPH_OK;
+  if (!ref->w || !ref->s)
+    st = sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
+  if (st == SPH_OK)
+    st = tl_reference_alloc(ref, 9, &ref->L, err);
+  if (st == SPH_OK)
+    st = tl_reference_alloc(ref, 9, &ref->Q, err);
+  if (st == SPH_OK)
+    st = sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL, ref->L,
+                                 err);
+  if (st == SPH_OK)
+    pair_weights(ref, &sim->kernel);
   free(id);
   sim->timers[timer].seconds += sph_wtime() - t0;
   sim->timers[timer].calls++;
@@ -336,8 +395,10 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
 
 void tl_reference_destroy(tl_reference *ref) {
   sph_neighbors_destroy(ref->nl);
-  free(ref->grad);
-  free(ref->rev);
+  free(ref->w);
+  free(ref->L);
+  free(ref->s);
+  free(ref->Q);
   free(ref->mat);
   free(ref->rho0);
   free(ref->X);

@@ -1,8 +1,9 @@
 /* What the total-Lagrangian methods share: the reference configuration
- * (same-body neighbours, corrected kernel gradients of seed 000 eq. 21 /
- * seed 001 eq. 8, reverse slots), mirror images across symmetry planes,
- * per-particle material and density, the state arrays, the derived output
- * fields and the energy. */
+ * (same-body neighbours, the pair weights and correction matrices of the
+ * corrected gradient of seed 000 eq. 21 / seed 001 eq. 8, see
+ * methods/tl_iact.h), the conservative force loop, mirror images across
+ * symmetry planes, per-particle material and density, the state arrays, the
+ * derived output fields and the energy. */
 #ifndef SPH_TL_COMMON_IMPL_H
 #define SPH_TL_COMMON_IMPL_H
 
@@ -12,6 +13,7 @@
 #include "sph/material.h"
 #include "sph/neighbors.h"
 #include "sph/sim.h"
+#include "sph/tensor.h"
 
 typedef struct tl_reference {
   size_t n, n_ext;          /* real particles, real + mirror images */
@@ -19,14 +21,16 @@ typedef struct tl_reference {
   double *V;                /* volumes (n_ext) */
   int32_t *body;            /* bodies (n_ext) */
   sph_neighbors *nl;        /* over all n_ext points, same body only */
-  double *grad;             /* corrected gradient per slot (3) */
-  size_t *rev;              /* slot of (b -> a) for slot (a -> b) */
+  double *w;                /* V_b W'(r_ab) / r_ab per slot */
+  double *L;                /* correction matrix per point (9 n_ext) */
+  double *s;                /* sum_b w_ab r_ab per particle (3 n) */
   const sph_material **mat; /* per point (n_ext) */
   double *rho0;             /* per point (n_ext) */
   double cp;                /* largest p-wave speed of the materials */
   /* state, n_ext entries each; the particle fields themselves when there
    * are no images */
   double *x, *p, *F, *J, *P;
+  double *Q; /* P L per point (9 n_ext) */
   int owns_state;
   /* mirror images */
   sph_mirror mirror;
@@ -43,6 +47,24 @@ typedef struct tl_reference {
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                sph_error *err);
 void tl_reference_destroy(tl_reference *ref);
+
+/* Slot of (b -> a) for every slot (a -> b), for pair quantities that are
+ * not antisymmetric (allocated here, freed by the caller). */
+sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **rev,
+                                      sph_error *err);
+
+/* Corrected gradient grad_b(X_a) of slot k of particle a (set-up use). */
+void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,
+                           double g[3]);
+
+/* Q_a = P_a L_a, the stress the conservative force pairs with */
+static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
+  sph_mat3_mul(ref->P + 9 * a, ref->L + 9 * a, ref->Q + 9 * a);
+}
+
+/* Internal force of seed 000 eq. 29c / 42 into dp (overwritten) for the
+ * real particles, from ref->Q (methods/tl_iact.h). */
+void tl_conservative_force(const tl_reference *ref, double *dp);
 
 /* Extra per-point state of n_ext entries (e.g. the cofactor). */
 sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,

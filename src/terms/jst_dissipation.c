@@ -15,22 +15,44 @@ typedef struct jst {
   double *d;  /* D(u) */
 } jst;
 
-static void laplacian(const jst *j, const double *V, const double *u,
-                      double *out, long n) {
+/* L[u]_a = sum_b (V_b Lap W~_b(X_a)) (u_b - u_a), one loop per component
+ * count so that the compiler sees it */
+static void laplacian3(const jst *j, const double *u, double *out, long n) {
   const sph_neighbors *nl = j->p.nl;
-  int nc = j->p.ncomp;
+  const double *wl = j->p.lap;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double s[3] = {0, 0, 0};
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    const double *ua = u + 3 * a;
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
-      size_t b = (size_t)nl->index[k];
-      double w = V[b] * j->p.lap[k];
-      for (int c = 0; c < nc; ++c)
-        s[c] += w * (u[nc * b + c] - u[nc * a + c]);
+      const double *ub = u + 3 * (size_t)nl->index[k];
+      s0 += wl[k] * (ub[0] - ua[0]);
+      s1 += wl[k] * (ub[1] - ua[1]);
+      s2 += wl[k] * (ub[2] - ua[2]);
     }
-    for (int c = 0; c < nc; ++c)
-      out[nc * a + c] = s[c];
+    out[3 * a] = s0;
+    out[3 * a + 1] = s1;
+    out[3 * a + 2] = s2;
   }
+}
+
+static void laplacian1(const jst *j, const double *u, double *out, long n) {
+  const sph_neighbors *nl = j->p.nl;
+  const double *wl = j->p.lap;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double s = 0.0;
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k)
+      s += wl[k] * (u[nl->index[k]] - u[a]);
+    out[a] = s;
+  }
+}
+
+static void laplacian(const jst *j, const double *u, double *out, long n) {
+  if (j->p.ncomp == 3)
+    laplacian3(j, u, out, n);
+  else
+    laplacian1(j, u, out, n);
 }
 
 static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
@@ -44,7 +66,7 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   double *rate = nc == 3 ? stage->dp : stage->dJ;
   double c2 = j->p.eps2 * j->p.cp * j->p.h;
   double c4 = j->p.eps4 * j->p.cp * j->p.h * j->p.h * j->p.h;
-  laplacian(j, V, u, j->lu, n);
+  laplacian(j, u, j->lu, n);
   if (sim->mirror) { /* the images' Laplacians mirror their sources' */
     if (nc == 3)
       sph_mirror_vector(sim->mirror, j->lu);
@@ -52,7 +74,7 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
       sph_mirror_scalar(sim->mirror, j->lu, 0.0);
   }
   if (c4 != 0.0)
-    laplacian(j, V, j->lu, j->d, n); /* L[L[u]] */
+    laplacian(j, j->lu, j->d, n); /* L[L[u]] */
   for (long i = 0; i < nc * n; ++i)
     j->d[i] = c2 * j->lu[i] - (c4 != 0.0 ? c4 * j->d[i] : 0.0);
   if (j->p.project) {

@@ -28,8 +28,8 @@ sph_status angular_momentum_projection_create(sph_sim *sim, sph_error *err);
  * speed. */
 typedef struct jst_params {
   const sph_neighbors *nl; /* may list mirror images beyond the particles */
-  const double *lap;
-  const double *V; /* volumes of every point of nl */
+  const double *lap;       /* V_b Lap W~_b(X_a) per slot */
+  const double *V;         /* volumes of every point of nl */
   int ncomp;
   double eps2, eps4, cp, h;
   int project;

@@ -26,9 +26,11 @@ static void deformation_and_stress(tl_csph *m, long n) {
     double F[9] = {0};
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      tl_csph_iact_deformation(F, ref->V[b], m->x + 3 * a, m->x + 3 * b,
-                               ref->grad + 3 * k);
+      double r[3];
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      tl_csph_iact_deformation(F, ref->w[k], m->x + 3 * a, m->x + 3 * b, r);
     }
+    tl_iact_gradient_correct(F, ref->L + 9 * a);
     memcpy(m->F + 9 * a, F, sizeof F);
   }
   if (ne > n) /* the images' F mirror their sources' */
@@ -39,28 +41,17 @@ static void deformation_and_stress(tl_csph *m, long n) {
     sph_mat3_cofactor(m->F + 9 * a, H);
     sph_material_stress(ref->mat[a], m->F + 9 * a, H,
                         sph_mat3_det(m->F + 9 * a), m->P + 9 * a);
+    tl_force_matrix(ref, (size_t)a);
   }
 }
 
 static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
   tl_csph *m = ctx;
   sph_sim *sim = m->sim;
-  const sph_neighbors *nl = m->ref.nl;
-  const double *V = m->ref.V;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   deformation_and_stress(m, n);
-#pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    double T[3] = {0, 0, 0};
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
-      size_t b = (size_t)nl->index[k];
-      tl_iact_force(T, V[b], m->P + 9 * a, m->P + 9 * b, m->ref.grad + 3 * k,
-                    m->ref.grad + 3 * m->ref.rev[k]);
-    }
-    for (int c = 0; c < 3; ++c)
-      m->dp[3 * a + c] = -T[c];
-  }
+  tl_conservative_force(&m->ref, m->dp);
   sim->timers[m->timer_force].seconds += sph_wtime() - t0;
   sim->timers[m->timer_force].calls++;
   sph_stage s = {

@@ -40,73 +40,124 @@ static void refresh_images(tl_jst *m) {
                       m->fields == TL_JST_PF ? NULL : m->J);
 }
 
+/* P, and Q = P L for the conservative force, of every point */
 static void compute_stress(tl_jst *m, long n) {
+  int conservative = m->force == TL_JST_CONSERVATIVE;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double Ha[9], Ja;
     strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
     sph_material_stress(m->ref.mat[a], m->F + 9 * a, Ha, Ja, m->P + 9 * a);
+    if (conservative)
+      tl_force_matrix(&m->ref, (size_t)a);
   }
 }
 
 /* ---- right-hand side (Algorithm 1 steps 4-8)
  * ------------------------------------ */
 
+/* Geometric conservation laws (eq. 41b-d) from the uncorrected momentum
+ * gradient G, the momentum rate dp (= -T) and dx = p / rho0 */
+static inline void particle_rates(tl_jst *m, size_t a, double G[9],
+                                  const double dp[3]) {
+  double inv_rho0 = 1.0 / m->ref.rho0[a];
+  tl_iact_gradient_correct(G, m->ref.L + 9 * a);
+  for (int k = 0; k < 9; ++k)
+    G[k] *= inv_rho0;
+  memcpy(m->dF + 9 * a, G, 9 * sizeof *G);
+  if (m->fields == TL_JST_PFHJ)
+    sph_mat3_tensor_cross(m->F + 9 * a, G, m->dH + 9 * a);
+  if (m->fields != TL_JST_PF) {
+    double Ha[9], Ja;
+    strain_measures(m, m->F, m->H, m->J, a, Ha, &Ja);
+    m->dJ[a] = sph_mat3_ddot(Ha, G);
+  }
+  for (int c = 0; c < 3; ++c) {
+    m->dp[3 * a + c] = dp[c];
+    m->dx[3 * a + c] = m->p[3 * a + c] * inv_rho0;
+  }
+}
+
+/* one sweep for the momentum gradient and the force of eq. 42 */
+static void sweep_conservative(tl_jst *m, long n) {
+  const tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double G[9] = {0}, f[3];
+    const double *pa = m->p + 3 * a;
+    sph_mat3_vec(ref->Q + 9 * a, ref->s + 3 * a, f);
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3];
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      tl_iact_force(f, ref->w[k], ref->Q + 9 * b, r);
+    }
+    particle_rates(m, (size_t)a, G, f);
+  }
+}
+
+/* the symmetric force of seed 003 eq. 11 with the corrected gradient, or
+ * (eq. 30) with the uncorrected one */
+static void sweep_symmetric(tl_jst *m, long n) {
+  const tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
+  int corrected = m->force == TL_JST_SYMMETRIC;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double G[9] = {0}, T[3] = {0, 0, 0};
+    const double *pa = m->p + 3 * a, *Pa = m->P + 9 * a;
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3], g[3];
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      for (int c = 0; c < 3; ++c)
+        r[c] *= ref->w[k];
+      if (corrected)
+        sph_mat3_vec(ref->L + 9 * a, r, g);
+      else
+        memcpy(g, r, sizeof g);
+      tl_jst_iact_force_symmetric(T, Pa, m->P + 9 * b, g);
+    }
+    double dp[3] = {-T[0], -T[1], -T[2]};
+    particle_rates(m, (size_t)a, G, dp);
+  }
+}
+
+/* the kernel-gradient force of seed 000 eq. 31 */
+static void sweep_eq31(tl_jst *m, long n) {
+  const tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
+  const double *V = ref->V;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double G[9] = {0}, T[3] = {0, 0, 0};
+    const double *pa = m->p + 3 * a;
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3];
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      tl_jst_iact_force_kernel(T, V[b], m->P + 9 * b, m->fgrad + 3 * m->rev[k]);
+    }
+    /* the b = a term of eq. 31 */
+    tl_jst_iact_force_kernel(T, V[a], m->P + 9 * a, m->fgrad_self + 3 * a);
+    double dp[3] = {-T[0], -T[1], -T[2]};
+    particle_rates(m, (size_t)a, G, dp);
+  }
+}
+
 static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
                              sph_error *err) {
   tl_jst *m = ctx;
   sph_sim *sim = m->sim;
-  const sph_neighbors *nl = m->ref.nl;
-  const double *V = m->ref.V;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_ext);
-#pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    double G[9] = {0}, T[3] = {0, 0, 0};
-    double inv_rho0 = 1.0 / m->ref.rho0[a];
-    const double *pa = m->p + 3 * a, *Pa = m->P + 9 * a;
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
-      size_t b = (size_t)nl->index[k];
-      const double *g = m->ref.grad + 3 * k;
-      tl_iact_gradient(G, V[b], pa, m->p + 3 * b, g);
-      switch (m->force) {
-      case TL_JST_CONSERVATIVE:
-        tl_iact_force(T, V[b], Pa, m->P + 9 * b, g,
-                      m->ref.grad + 3 * m->ref.rev[k]);
-        break;
-      case TL_JST_SYMMETRIC:
-        tl_jst_iact_force_symmetric(T, V[b], Pa, m->P + 9 * b, g);
-        break;
-      case TL_JST_EQ30:
-        tl_jst_iact_force_symmetric(T, V[b], Pa, m->P + 9 * b,
-                                    m->fgrad + 3 * k);
-        break;
-      case TL_JST_EQ31:
-        tl_jst_iact_force_kernel(T, V[b], m->P + 9 * b,
-                                 m->fgrad + 3 * m->ref.rev[k]);
-        break;
-      }
-    }
-    if (m->force == TL_JST_EQ31) /* the b = a term of eq. 31 */
-      tl_jst_iact_force_kernel(T, V[a], Pa, m->fgrad_self + 3 * a);
-    /* geometric conservation laws (eq. 41b-d) and dx = p / rho0 */
-    for (int k = 0; k < 9; ++k)
-      G[k] *= inv_rho0;
-    memcpy(m->dF + 9 * a, G, sizeof G);
-    if (m->fields == TL_JST_PFHJ)
-      sph_mat3_tensor_cross(m->F + 9 * a, G, m->dH + 9 * a);
-    if (m->fields != TL_JST_PF) {
-      double Ha[9], Ja;
-      strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
-      m->dJ[a] = sph_mat3_ddot(Ha, G);
-    }
-    for (int c = 0; c < 3; ++c) {
-      m->dp[3 * a + c] = -T[c];
-      m->dx[3 * a + c] = pa[c] * inv_rho0;
-    }
-  }
+  m->sweep(m, n);
   /* X^chi of eq. 45: x^n, then x^n + dt / (2 rho0) (p^n + p*) */
   const double *xm = m->x;
   if (stage > 0) {
@@ -184,6 +235,7 @@ static void tl_jst_destroy(sph_sim *sim) {
   free(m->lap);
   free(m->fgrad);
   free(m->fgrad_self);
+  free(m->rev);
   free(m->x0);
   free(m->p0);
   free(m->F0);
@@ -315,12 +367,15 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .volume = m->ref.V,
                      .nl = m->ref.nl,
                      .kernel = &sim->kernel};
-  if (m->force == TL_JST_EQ30 || m->force == TL_JST_EQ31) {
+  m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
+             : m->force == TL_JST_EQ31       ? sweep_eq31
+                                             : sweep_symmetric;
+  if (m->force == TL_JST_EQ31) {
     SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
     SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
-    SPH_TRY(sph_correction_gradient(
-        &cloud, m->force == TL_JST_EQ30 ? SPH_GRAD_UNCORRECTED : SPH_GRAD_W1,
-        m->fgrad, m->fgrad_self, NULL, err));
+    SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
+                                    m->fgrad_self, NULL, err));
+    SPH_TRY(tl_reference_reverse_slots(&m->ref, &m->rev, err));
   }
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
@@ -334,14 +389,16 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
         for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1];
              ++k) {
           size_t b = (size_t)m->ref.nl->index[k];
-          double r[3], r2 = 0.0;
-          for (int c = 0; c < 3; ++c) {
-            r[c] = X[3 * a + c] - X[3 * b + c];
-            r2 += r[c] * r[c];
-          }
-          m->lap[k] = -2.0 * sph_vec3_dot(r, m->ref.grad + 3 * k) / r2;
+          double r[3], g[3];
+          tl_iact_pair_vector(X, a, b, r);
+          tl_reference_gradient(&m->ref, a, k, g);
+          m->lap[k] = -2.0 * sph_vec3_dot(r, g) / sph_vec3_dot(r, r);
         }
     }
+    /* the JST term takes V_b Lap W~_b(X_a) */
+    for (size_t a = 0; a < ne; ++a)
+      for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k)
+        m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
   }
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
 

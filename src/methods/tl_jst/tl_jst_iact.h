@@ -7,10 +7,9 @@
 
 #include "sph/tensor.h"
 
-/* Symmetric force of seed 003 eq. 11: dp_a += V_b (P_a + P_b) grad_b(X_a),
- * accumulated as T_a -= ... so that dp = -T */
-static inline void tl_jst_iact_force_symmetric(double T[3], double Vb,
-                                               const double Pa[9],
+/* Symmetric force of seed 003 eq. 11: dp_a += (P_a + P_b) V_b grad_b(X_a),
+ * accumulated as T_a -= ... so that dp = -T; g_ab = V_b grad_b(X_a) */
+static inline void tl_jst_iact_force_symmetric(double T[3], const double Pa[9],
                                                const double Pb[9],
                                                const double g_ab[3]) {
   double S[9];
@@ -19,7 +18,7 @@ static inline void tl_jst_iact_force_symmetric(double T[3], double Vb,
   double u[3];
   sph_mat3_vec(S, g_ab, u);
   for (int i = 0; i < 3; ++i)
-    T[i] -= Vb * u[i];
+    T[i] -= u[i];
 }
 
 /* Kernel-gradient force of seed 000 eq. 31: T_a += V_b P_b gradW~_a(X_b)

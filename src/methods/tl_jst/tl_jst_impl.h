@@ -21,9 +21,12 @@ typedef struct tl_jst {
   double cfl;
   int current_wave_speed; /* dt from the current state's c_p */
   tl_reference ref;       /* neighbours, gradients, materials */
-  double *lap;            /* Laplacian weight per slot (NULL if unused) */
-  double *fgrad;          /* force gradients per slot (eq. 30, 31 only) */
+  double *lap;            /* V_b Lap W~_b(X_a) per slot (NULL if unused) */
+  double *fgrad;          /* eq. 31: grad W~1_b(X_a) per slot */
   double *fgrad_self;     /* eq. 31: grad W~1_a(X_a) per particle */
+  size_t *rev;            /* eq. 31: slot of (b -> a) for slot (a -> b) */
+  /* the pair sweep of the chosen force, picked once at set-up */
+  void (*sweep)(struct tl_jst *m, long n);
   /* state (particle fields) and its RK copies and rates */
   double *x, *p, *F, *H, *J;
   double *x0, *p0, *F0, *H0, *J0;
