@@ -554,7 +554,8 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
   size_t n = fr->ps->n, m = 0;
   int nc = p->ncomp;
   double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
-  for (size_t a = 0; a < n; ++a) {
+  for (size_t j = 0; j < n; ++j) { /* creation order, as the VTK files */
+    size_t a = sph_particles_slot(fr->ps, j);
     double v = field ? particle_value(field, nc, a) : NAN;
     if (isfinite(v)) {
       vmin = fmin(vmin, v);

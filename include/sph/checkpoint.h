@@ -21,7 +21,8 @@
 #include "sph/stability.h"
 #include "sph/status.h"
 
-#define SPH_CHECKPOINT_VERSION 2u
+/* 3: particles in Morton storage order (sph_particles_sort_morton) */
+#define SPH_CHECKPOINT_VERSION 3u
 #define SPH_CHECKPOINT_FILE "checkpoint.sphc"
 #define SPH_CHECKPOINT_PREVIOUS "checkpoint.prev.sphc"
 

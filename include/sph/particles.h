@@ -51,8 +51,9 @@ typedef struct sph_particles {
   int dim;                        /* 2 or 3 (storage is always 3 components) */
   double *field[SPH_FIELD_COUNT]; /* NULL until required */
   int64_t *id;                    /* stable particle id, 0..n-1 at creation */
-  int32_t *body;                  /* index of the body in the scene */
-  uint32_t *flags;                /* SPH_FLAG_* */
+  int64_t *slot;   /* storage index of id j after a reorder (NULL: none) */
+  int32_t *body;   /* index of the body in the scene */
+  uint32_t *flags; /* SPH_FLAG_* */
 } sph_particles;
 
 const char *sph_field_name(sph_field f);
@@ -80,5 +81,18 @@ sph_status sph_particles_append(sph_particles *ps, const double X[3],
 
 /* Bytes held by the allocated fields. */
 size_t sph_particles_bytes(const sph_particles *ps);
+
+/* Reorders the particles (every field and attribute) along a Morton
+ * (Z-order) curve of cubic cells of edge `cell` over their initial
+ * positions, particles of one cell keeping their order, so that neighbours
+ * are near in memory; fills ps->slot. Outputs that list particles use
+ * sph_particles_slot to keep the creation order. Set-up only. */
+sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
+                                     sph_error *err);
+
+/* storage index of the particle created j-th */
+static inline size_t sph_particles_slot(const sph_particles *ps, size_t j) {
+  return ps->slot ? (size_t)ps->slot[j] : j;
+}
 
 #endif

@@ -1,6 +1,7 @@
 /* Particle storage (structure of arrays, fields allocated on demand). */
 #include "sph/particles.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -68,6 +69,7 @@ void sph_particles_destroy(sph_particles *ps) {
   for (int f = 0; f < SPH_FIELD_COUNT; ++f)
     free(ps->field[f]);
   free(ps->id);
+  free(ps->slot);
   free(ps->body);
   free(ps->flags);
   free(ps);
@@ -96,6 +98,8 @@ sph_status sph_particles_append(sph_particles *ps, const double X[3],
   memcpy(ps->field[SPH_FIELD_POSITION0] + 3 * i, X, 3 * sizeof *X);
   ps->field[SPH_FIELD_VOLUME0][i] = volume;
   ps->id[i] = (int64_t)i;
+  if (ps->slot)
+    ps->slot[i] = (int64_t)i;
   ps->body[i] = body;
   ps->flags[i] = 0;
   return SPH_OK;
@@ -107,5 +111,85 @@ size_t sph_particles_bytes(const sph_particles *ps) {
   for (int f = 0; f < SPH_FIELD_COUNT; ++f)
     if (ps->field[f])
       bytes += ps->capacity * (size_t)field_ncomp[f] * sizeof(double);
+  if (ps->slot)
+    bytes += ps->capacity * sizeof *ps->slot;
   return bytes;
+}
+
+/* ---- Morton order
+ * ------------------------------------------------------------- */
+
+typedef struct morton_key {
+  uint64_t key;
+  size_t index;
+} morton_key;
+
+/* the 21 low bits of v spread to every third bit */
+static uint64_t spread3(uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffull;
+  v = (v | v << 16) & 0x1f0000ff0000ffull;
+  v = (v | v << 8) & 0x100f00f00f00f00full;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+  v = (v | v << 2) & 0x1249249249249249ull;
+  return v;
+}
+
+static int cmp_key(const void *pa, const void *pb) {
+  const morton_key *a = pa, *b = pb;
+  if (a->key != b->key)
+    return a->key < b->key ? -1 : 1;
+  return a->index < b->index ? -1 : a->index > b->index;
+}
+
+/* out[i] = in[perm[i]] for records of `size` bytes */
+static void permute(void *data, void *tmp, const morton_key *k, size_t n,
+                    size_t size) {
+  char *d = data, *t = tmp;
+  for (size_t i = 0; i < n; ++i)
+    memcpy(t + i * size, d + k[i].index * size, size);
+  memcpy(d, t, n * size);
+}
+
+sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
+                                     sph_error *err) {
+  size_t n = ps->n;
+  if (n < 2 || !(cell > 0.0))
+    return SPH_OK;
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  double lo[3] = {INFINITY, INFINITY, INFINITY};
+  for (size_t a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c)
+      lo[c] = fmin(lo[c], X[3 * a + c]);
+  morton_key *k = malloc(n * sizeof *k);
+  void *tmp = malloc(n * 9 * sizeof(double));
+  int64_t *slot = ps->slot ? ps->slot : malloc(ps->capacity * sizeof *slot);
+  if (!k || !tmp || !slot) {
+    free(k);
+    free(tmp);
+    if (slot != ps->slot)
+      free(slot);
+    return sph_error_set(err, SPH_ERR_NOMEM, "particle order (%zu)", n);
+  }
+  for (size_t a = 0; a < n; ++a) {
+    uint64_t key = 0;
+    for (int c = 0; c < 3; ++c) {
+      double q = floor((X[3 * a + c] - lo[c]) / cell);
+      key |= spread3((uint64_t)fmin(fmax(q, 0.0), 2097151.0)) << c;
+    }
+    k[a] = (morton_key){key, a};
+  }
+  qsort(k, n, sizeof *k, cmp_key);
+  for (int f = 0; f < SPH_FIELD_COUNT; ++f)
+    if (ps->field[f])
+      permute(ps->field[f], tmp, k, n, (size_t)field_ncomp[f] * sizeof(double));
+  permute(ps->id, tmp, k, n, sizeof *ps->id);
+  permute(ps->body, tmp, k, n, sizeof *ps->body);
+  permute(ps->flags, tmp, k, n, sizeof *ps->flags);
+  for (size_t i = 0; i < n; ++i)
+    slot[ps->id[i]] = (int64_t)i;
+  ps->slot = slot;
+  free(k);
+  free(tmp);
+  return SPH_OK;
 }

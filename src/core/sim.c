@@ -51,6 +51,9 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
     st = sph_kernel_create(&sim->kernel, scene->kernel_type, scene->dimension,
                            scene->h_over_dp * sim->dp, err);
   }
+  /* neighbours near in memory: cells of one kernel support in Morton order */
+  if (st == SPH_OK)
+    st = sph_particles_sort_morton(sim->ps, sim->kernel.support, err);
   if (st == SPH_OK)
     st = sph_reference_create(&sim->reference, scene, err);
   if (st == SPH_OK && sim->reference)

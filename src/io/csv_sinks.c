@@ -100,7 +100,8 @@ static sph_status probe_open(sph_sink *sink, const sph_sim *sim,
   sink->data = p;
   for (size_t k = 0; k < s->output.nprobes; ++k) {
     double best = INFINITY;
-    for (size_t a = 0; a < ps->n; ++a) {
+    for (size_t j = 0; j < ps->n; ++j) { /* ties: the first created */
+      size_t a = sph_particles_slot(ps, j);
       const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
       double d = 0.0;
       for (int c = 0; c < 3; ++c)

@@ -5,7 +5,8 @@
  * asks for; and a .pvd collection with the physical time of every file,
  * rewritten after each frame so a running or killed simulation always
  * loads in ParaView. Every file is written to a temporary name, fsync'd
- * and renamed. */
+ * and renamed. Particles are listed in creation order whatever their
+ * storage order (sph_particles_sort_morton). */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +29,15 @@ typedef struct array_desc {
   const char *type; /* Float64, Int64, Int32 */
   int ncomp;
   const void *data;
+  const int64_t *slot; /* per-particle data in storage order, or NULL */
 } array_desc;
+
+/* element i of the listing (component i % ncomp of particle i / ncomp) */
+static const char *element(const array_desc *a, size_t i, size_t size) {
+  size_t nc = (size_t)a->ncomp, j = i / nc;
+  size_t at = a->slot ? (size_t)a->slot[j] * nc + i % nc : i;
+  return (const char *)a->data + at * size;
+}
 
 static size_t type_size(const char *type) {
   return strcmp(type, "Int32") ? 8 : 4;
@@ -63,25 +72,29 @@ static int frame_arrays(const sph_frame *fr, array_desc *out, int max) {
     sph_field f = (sph_field)o->fields[i];
     if (!fr->ps->field[f])
       continue; /* the method does not provide it */
-    out[k++] = (array_desc){sph_field_name(f), "Float64",
-                            sph_field_components(f), fr->ps->field[f]};
+    out[k++] =
+        (array_desc){sph_field_name(f), "Float64", sph_field_components(f),
+                     fr->ps->field[f], fr->ps->slot};
   }
   if (o->body_id && k < max)
-    out[k++] = (array_desc){"body_id", "Int32", 1, fr->ps->body};
+    out[k++] = (array_desc){"body_id", "Int32", 1, fr->ps->body, fr->ps->slot};
   if (o->particle_id && k < max)
-    out[k++] = (array_desc){"particle_id", "Int64", 1, fr->ps->id};
+    out[k++] =
+        (array_desc){"particle_id", "Int64", 1, fr->ps->id, fr->ps->slot};
   return k;
 }
 
 static void write_ascii(FILE *f, const array_desc *a, size_t n) {
   size_t count = n * (size_t)a->ncomp;
+  size_t size = type_size(a->type);
   for (size_t i = 0; i < count; ++i) {
+    const void *e = element(a, i, size);
     if (!strcmp(a->type, "Float64"))
-      fprintf(f, "%.17g", ((const double *)a->data)[i]);
+      fprintf(f, "%.17g", *(const double *)e);
     else if (!strcmp(a->type, "Int64"))
-      fprintf(f, "%lld", (long long)((const int64_t *)a->data)[i]);
+      fprintf(f, "%lld", (long long)*(const int64_t *)e);
     else
-      fprintf(f, "%d", (int)((const int32_t *)a->data)[i]);
+      fprintf(f, "%d", (int)*(const int32_t *)e);
     fputc(i + 1 < count ? ' ' : '\n', f);
   }
 }
@@ -103,9 +116,21 @@ static void data_array(FILE *f, const vtk_sink *v, const array_desc *a,
 }
 
 static void append_block(FILE *f, const array_desc *a, size_t n) {
-  uint64_t bytes = n * (size_t)a->ncomp * type_size(a->type);
+  size_t size = type_size(a->type), count = n * (size_t)a->ncomp;
+  uint64_t bytes = count * size;
   fwrite(&bytes, sizeof bytes, 1, f); /* x86-64 and arm64: little endian */
-  fwrite(a->data, 1, bytes, f);
+  if (!a->slot) {
+    fwrite(a->data, 1, bytes, f);
+    return;
+  }
+  char buf[8192];
+  for (size_t i = 0, used = 0; i < count; ++i) {
+    memcpy(buf + used, element(a, i, size), size);
+    if ((used += size) == sizeof buf || i + 1 == count) {
+      fwrite(buf, 1, used, f);
+      used = 0;
+    }
+  }
 }
 
 static sph_status write_pvd(vtk_sink *v, sph_error *err) {
@@ -142,10 +167,10 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
   const double *x = fr->ps->field[SPH_FIELD_POSITION]
                         ? fr->ps->field[SPH_FIELD_POSITION]
                         : fr->ps->field[SPH_FIELD_POSITION0];
-  array_desc points = {"Points", "Float64", 3, x};
+  array_desc points = {"Points", "Float64", 3, x, fr->ps->slot};
   for (size_t i = 0; i < n; ++i)
     v->ids[i] = (int64_t)i; /* connectivity i, offsets i + 1 */
-  array_desc conn = {"connectivity", "Int64", 1, v->ids};
+  array_desc conn = {"connectivity", "Int64", 1, v->ids, NULL};
   sph_atomic_file af;
   SPH_TRY(sph_atomic_open(&af, path, err));
   FILE *f = af.f;

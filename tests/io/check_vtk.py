@@ -112,6 +112,12 @@ def main():
             fail("%s: points differ between binary and ASCII" % path_b)
         # points = initial position + displacement
         X, U = b["initial_position"][1], b["displacement"][1]
+        # creation order whatever the storage order: ids 0..n-1 and the
+        # box lattice with x slowest, z fastest
+        if [int(v) for v in b["particle_id"][1]] != list(range(n)):
+            fail("%s: particle_id is not 0..%d in order" % (path_b, n - 1))
+        if any(tuple(X[j]) >= tuple(X[j + 1]) for j in range(n - 1)):
+            fail("%s: particles are not listed in creation order" % path_b)
         for p, x0, u in zip(b["points"], X, U):
             if any(not close(p[c], x0[c] + u[c], 1e-12) for c in range(3)):
                 fail("%s: point %s != X + u" % (path_b, p))
