@@ -268,15 +268,20 @@ void tl_conservative_force(const tl_reference *ref, double *dp) {
   long n = (long)ref->n;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double f[3];
-    sph_mat3_vec(ref->Q + 9 * a, ref->s + 3 * a, f);
+    const double *Xa = ref->X + 3 * a;
+    tl_sums s = {0};
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      double r[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_iact_force(f, ref->w[k], ref->Q + 9 * b, r);
+      tl_v2 r01;
+      double r2;
+      tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
+      tl_iact_force2(&s, ref->w[k], ref->Qt + 9 * b, r01, r2);
     }
-    memcpy(dp + 3 * a, f, sizeof f);
+    double G[9], f[3], self[3];
+    tl_sums_store(&s, G, f);
+    tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
+    for (int c = 0; c < 3; ++c)
+      dp[3 * a + c] = f[c] + self[c];
   }
 }
 
@@ -381,7 +386,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   if (st == SPH_OK)
     st = tl_reference_alloc(ref, 9, &ref->L, err);
   if (st == SPH_OK)
-    st = tl_reference_alloc(ref, 9, &ref->Q, err);
+    st = tl_reference_alloc(ref, 9, &ref->Qt, err);
   if (st == SPH_OK)
     st = sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL, ref->L,
                                  err);
@@ -398,7 +403,7 @@ void tl_reference_destroy(tl_reference *ref) {
   free(ref->w);
   free(ref->L);
   free(ref->s);
-  free(ref->Q);
+  free(ref->Qt);
   free(ref->mat);
   free(ref->rho0);
   free(ref->X);

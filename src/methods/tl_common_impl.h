@@ -30,7 +30,7 @@ typedef struct tl_reference {
   /* state, n_ext entries each; the particle fields themselves when there
    * are no images */
   double *x, *p, *F, *J, *P;
-  double *Q; /* P L per point (9 n_ext) */
+  double *Qt; /* (P L)^T per point (9 n_ext) */
   int owns_state;
   /* mirror images */
   sph_mirror mirror;
@@ -57,13 +57,16 @@ sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **rev,
 void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,
                            double g[3]);
 
-/* Q_a = P_a L_a, the stress the conservative force pairs with */
+/* Q_a = P_a L_a, the stress the conservative force pairs with, stored
+ * transposed (its columns contiguous) */
 static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
-  sph_mat3_mul(ref->P + 9 * a, ref->L + 9 * a, ref->Q + 9 * a);
+  double Q[9];
+  sph_mat3_mul(ref->P + 9 * a, ref->L + 9 * a, Q);
+  sph_mat3_transpose(Q, ref->Qt + 9 * a);
 }
 
 /* Internal force of seed 000 eq. 29c / 42 into dp (overwritten) for the
- * real particles, from ref->Q (methods/tl_iact.h). */
+ * real particles, from ref->Qt (methods/tl_iact.h). */
 void tl_conservative_force(const tl_reference *ref, double *dp);
 
 /* Extra per-point state of n_ext entries (e.g. the cofactor). */

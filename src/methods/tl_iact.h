@@ -7,7 +7,66 @@
 #ifndef SPH_TL_IACT_H
 #define SPH_TL_IACT_H
 
+#include <string.h>
+
 #include "sph/tensor.h"
+
+/* Two doubles in one register (GCC and Clang vector extension), so that a
+ * sweep keeps its twelve sums in registers rather than on the stack. */
+typedef double tl_v2 __attribute__((vector_size(16)));
+
+static inline tl_v2 tl_v2_load(const double *p) {
+  tl_v2 v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+
+/* A particle's pair sums: the gradient rows (G_i0, G_i1) and G_i2, and the
+ * force (f_0, f_1) and f_2. */
+typedef struct tl_sums {
+  tl_v2 g01[3];
+  double g2[3];
+  tl_v2 f01;
+  double f2;
+} tl_sums;
+
+/* r_ab = X_a - X_b as (r_0, r_1) and r_2 */
+static inline void tl_iact_pair_vector2(const double *Xa, const double *Xb,
+                                        tl_v2 *r01, double *r2) {
+  *r01 = tl_v2_load(Xa) - tl_v2_load(Xb);
+  *r2 = Xa[2] - Xb[2];
+}
+
+/* tl_iact_gradient on the register sums */
+static inline void tl_iact_gradient2(tl_sums *s, double w, const double fa[3],
+                                     const double fb[3], tl_v2 r01, double r2) {
+  for (int i = 0; i < 3; ++i) {
+    double d = w * (fb[i] - fa[i]);
+    s->g01[i] += d * r01;
+    s->g2[i] += d * r2;
+  }
+}
+
+/* tl_iact_force on the register sums, with Q_b stored transposed */
+static inline void tl_iact_force2(tl_sums *s, double w, const double Qtb[9],
+                                  tl_v2 r01, double r2) {
+  double r0 = w * r01[0], r1 = w * r01[1], wr2 = w * r2;
+  s->f01 += r0 * tl_v2_load(Qtb) + r1 * tl_v2_load(Qtb + 3) +
+            wr2 * tl_v2_load(Qtb + 6);
+  s->f2 += r0 * Qtb[2] + r1 * Qtb[5] + wr2 * Qtb[8];
+}
+
+/* the sums as G[9] and f[3] */
+static inline void tl_sums_store(const tl_sums *s, double G[9], double f[3]) {
+  for (int i = 0; i < 3; ++i) {
+    G[3 * i] = s->g01[i][0];
+    G[3 * i + 1] = s->g01[i][1];
+    G[3 * i + 2] = s->g2[i];
+  }
+  f[0] = s->f01[0];
+  f[1] = s->f01[1];
+  f[2] = s->f2;
+}
 
 /* r_ab = X_a - X_b */
 static inline void tl_iact_pair_vector(const double *X, size_t a, size_t b,
@@ -44,12 +103,12 @@ static inline void tl_iact_gradient_correct(double G[9], const double L[9]) {
  * Galerkin force of seed 001 eq. 11 with the corrected gradient),
  * -T_a = sum_b V_b (P_a grad_b(X_a) - P_b grad_a(X_b))
  *      = Q_a s_a + sum_b w_ab Q_b r_ab with Q = P L and s_a = sum_b w_ab r_ab:
- * this adds the pair's share w_ab Q_b r_ab to dp_a. */
-static inline void tl_iact_force(double dp[3], double w, const double Qb[9],
-                                 const double r[3]) {
+ * tl_iact_force2 adds the pair's share w_ab Q_b r_ab, this the Q_a s_a part
+ * (Q stored transposed). */
+static inline void tl_iact_force_self(const double Qta[9], const double sa[3],
+                                      double out[3]) {
   for (int i = 0; i < 3; ++i)
-    dp[i] +=
-        w * (Qb[3 * i] * r[0] + Qb[3 * i + 1] * r[1] + Qb[3 * i + 2] * r[2]);
+    out[i] = Qta[i] * sa[0] + Qta[3 + i] * sa[1] + Qta[6 + i] * sa[2];
 }
 
 #endif

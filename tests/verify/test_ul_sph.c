@@ -78,7 +78,6 @@ START_TEST(corrected_gradient_is_exact_for_linear_fields) {
   int n = lattice(x, dp, 4);
   const double A[9] = {0.3, -1.2, 0, 2.0, 0.7, 0, 0, 0, 0};
   double M[9] = {0}, L[9] = {0}, rot[3] = {0};
-  const double mI[9] = {-1, 0, 0, 0, -1, 0, 0, 0, -1};
   double V = dp * dp, vi[3] = {0};
   for (int b = 0; b < n; ++b) {
     double d[3] = {-x[b][0], -x[b][1], 0}, r = sph_vec3_norm(d);
@@ -87,7 +86,7 @@ START_TEST(corrected_gradient_is_exact_for_linear_fields) {
     double e[3] = {d[0] / r, d[1] / r, 0}, vb[3], dW = sph_kernel_dwdr(&k, r);
     sph_mat3_vec(A, x[b], vb);
     ul_sph_iact_moment(M, V, r, dW, e);
-    ul_sph_iact_velocity_gradient(L, V, vi, vb, mI, dW, e);
+    ul_sph_iact_velocity_gradient(L, V, vi, vb, dW, e);
     /* a rigid rotation v = w x x has e . v_ij = 0 for every pair */
     double w[3] = {-x[b][1], x[b][0], 0};
     ul_sph_iact_laplacian(rot, V, vi, w, r, dW, e);

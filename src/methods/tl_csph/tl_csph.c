@@ -23,13 +23,18 @@ static void deformation_and_stress(tl_csph *m, long n) {
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double F[9] = {0};
+    const double *Xa = ref->X + 3 * a;
+    tl_sums s = {0};
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      double r[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_csph_iact_deformation(F, ref->w[k], m->x + 3 * a, m->x + 3 * b, r);
+      tl_v2 r01;
+      double r2;
+      tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
+      tl_csph_iact_deformation(&s, ref->w[k], m->x + 3 * a, m->x + 3 * b, r01,
+                               r2);
     }
+    double F[9], unused[3];
+    tl_sums_store(&s, F, unused);
     tl_iact_gradient_correct(F, ref->L + 9 * a);
     memcpy(m->F + 9 * a, F, sizeof F);
   }

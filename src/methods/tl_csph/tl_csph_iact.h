@@ -8,11 +8,11 @@
 
 #include "methods/tl_iact.h"
 
-static inline void tl_csph_iact_deformation(double F[9], double w,
+static inline void tl_csph_iact_deformation(tl_sums *s, double w,
                                             const double xa[3],
-                                            const double xb[3],
-                                            const double r[3]) {
-  tl_iact_gradient(F, w, xa, xb, r);
+                                            const double xb[3], tl_v2 r01,
+                                            double r2) {
+  tl_iact_gradient2(s, w, xa, xb, r01, r2);
 }
 
 #endif

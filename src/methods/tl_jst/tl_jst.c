@@ -84,16 +84,21 @@ static void sweep_conservative(tl_jst *m, long n) {
   const sph_neighbors *nl = ref->nl;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double G[9] = {0}, f[3];
-    const double *pa = m->p + 3 * a;
-    sph_mat3_vec(ref->Q + 9 * a, ref->s + 3 * a, f);
+    const double *pa = m->p + 3 * a, *Xa = ref->X + 3 * a;
+    tl_sums s = {0};
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      double r[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
-      tl_iact_force(f, ref->w[k], ref->Q + 9 * b, r);
+      tl_v2 r01;
+      double r2;
+      tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
+      tl_iact_gradient2(&s, ref->w[k], pa, m->p + 3 * b, r01, r2);
+      tl_iact_force2(&s, ref->w[k], ref->Qt + 9 * b, r01, r2);
     }
+    double G[9], f[3], self[3];
+    tl_sums_store(&s, G, f);
+    tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
+    for (int c = 0; c < 3; ++c)
+      f[c] += self[c];
     particle_rates(m, (size_t)a, G, f);
   }
 }

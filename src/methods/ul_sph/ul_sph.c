@@ -164,15 +164,15 @@ static void accelerations(ul_sph *m, double *acc, double *accs) {
       size_t b = (size_t)nl->index[s];
       const double *e = m->e + 3 * s;
       double Vb = m->vol[b];
-      ul_riemann rs = ul_sph_iact_riemann(e, va, m->v + 3 * b, m->rho[a],
-                                          m->rho[b], m->p[a], m->p[b], m->c0[a],
-                                          m->c0[b], 0, m->limited);
+      double pstar = ul_sph_iact_riemann_pstar(e, va, m->v + 3 * b, m->rho[a],
+                                               m->rho[b], m->p[a], m->p[b],
+                                               m->c0[a], m->c0[b], m->limited);
       if (body[a] != body[b]) { /* bodies push, never pull */
-        if (rs.pstar > 0.0)
-          ul_sph_iact_pressure(ap, Vb, rs.pstar, m->dW[s], e);
+        if (pstar > 0.0)
+          ul_sph_iact_pressure(ap, Vb, pstar, m->dW[s], e);
         continue;
       }
-      ul_sph_iact_pressure(ap, Vb, rs.pstar, m->dW[s], e);
+      ul_sph_iact_pressure(ap, Vb, pstar, m->dW[s], e);
       if (m->shear == UL_SHEAR_LAPLACIAN)
         continue;
       ul_sph_iact_shear_stress(as, Vb, m->sigma + 9 * a, m->sigma + 9 * b,
@@ -207,27 +207,28 @@ static void continuity_and_shear(ul_sph *m, double dt) {
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double dr = 0.0, lap[3] = {0, 0, 0}, M[9] = {0}, L[9] = {0};
-    static const double minus_I[9] = {-1, 0, 0, 0, -1, 0, 0, 0, -1};
     const double *va = m->v + 3 * a;
     for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
       size_t b = (size_t)nl->index[s];
       const double *e = m->e + 3 * s, *vb = m->v + 3 * b;
       double Vb = m->vol[b];
-      ul_riemann rs =
-          ul_sph_iact_riemann(e, va, vb, m->rho[a], m->rho[b], m->p[a], m->p[b],
-                              m->c0[a], m->c0[b], pt, m->limited);
+      double du =
+          ul_sph_iact_riemann_du(e, va, vb, m->rho[a], m->rho[b], m->p[a],
+                                 m->p[b], m->c0[a], m->c0[b], pt);
       if (body[a] != body[b]) { /* contact: only while it pushes */
-        if (rs.pstar > 0.0)
-          dr += ul_sph_iact_continuity(Vb, rs.du, m->dW[s]);
+        if (ul_sph_iact_riemann_pstar(e, va, vb, m->rho[a], m->rho[b], m->p[a],
+                                      m->p[b], m->c0[a], m->c0[b],
+                                      m->limited) > 0.0)
+          dr += ul_sph_iact_continuity(Vb, du, m->dW[s]);
         continue;
       }
-      dr += ul_sph_iact_continuity(Vb, rs.du, m->dW[s]);
+      dr += ul_sph_iact_continuity(Vb, du, m->dW[s]);
       if (m->shear == UL_SHEAR_LAPLACIAN)
         ul_sph_iact_laplacian(lap, Vb, va, vb, m->r[s], m->dW[s], e);
       if (m->stress) {
         if (m->shear == UL_SHEAR_LAPLACIAN)
           ul_sph_iact_moment(M, Vb, m->r[s], m->dW[s], e);
-        ul_sph_iact_velocity_gradient(L, Vb, va, vb, minus_I, m->dW[s], e);
+        ul_sph_iact_velocity_gradient(L, Vb, va, vb, m->dW[s], e);
       }
     }
     m->drho[a] = m->rho[a] * dr;

@@ -22,25 +22,48 @@ typedef struct ul_riemann {
   double pstar; /* P* */
 } ul_riemann;
 
-/* eq. 13-16; `pressure_term` keeps (P_L - P_R) / (z_L + z_R) in U*;
- * `limited` applies the limiter beta of eq. 16 (dissipation only while the
- * pair approaches, growing with its Mach number), else beta = 1 for every
- * pair (the unlimited dissipative solver of the authors' code) */
+/* eq. 13-14: the dissipative velocity jump U_L - U* alone (what the
+ * continuity equation needs); `pressure_term` keeps (P_L - P_R) / (z_L +
+ * z_R) in U* */
+static inline double ul_sph_iact_riemann_du(const double e[3],
+                                            const double vi[3],
+                                            const double vj[3], double rho_i,
+                                            double rho_j, double p_i,
+                                            double p_j, double c_i, double c_j,
+                                            int pressure_term) {
+  double jump = sph_vec3_dot(vj, e) - sph_vec3_dot(vi, e);
+  double zL = rho_i * c_i, zR = rho_j * c_j;
+  return (zR * jump - (pressure_term ? p_i - p_j : 0.0)) * (1.0 / (zL + zR));
+}
+
+/* eq. 13-16: P*; `limited` applies the limiter beta of eq. 16 (dissipation
+ * only while the pair approaches, growing with its Mach number), else
+ * beta = 1 for every pair (the unlimited dissipative solver of the
+ * authors' code) */
+static inline double ul_sph_iact_riemann_pstar(
+    const double e[3], const double vi[3], const double vj[3], double rho_i,
+    double rho_j, double p_i, double p_j, double c_i, double c_j, int limited) {
+  double jump = sph_vec3_dot(vj, e) - sph_vec3_dot(vi, e);
+  double zL = rho_i * c_i, zR = rho_j * c_j;
+  double beta = 1.0;
+  if (limited) { /* clamped to [0, 1] without branches */
+    beta = 6.0 * jump / (c_i + c_j);
+    beta = 0.5 * (beta + fabs(beta)); /* max(beta, 0) exactly, no branch */
+    beta = beta < 1.0 ? beta : 1.0;
+  }
+  return (zL * p_j + zR * p_i + beta * zL * zR * jump) * (1.0 / (zL + zR));
+}
+
+/* both parts (tests and the contact pairs) */
 static inline ul_riemann
 ul_sph_iact_riemann(const double e[3], const double vi[3], const double vj[3],
                     double rho_i, double rho_j, double p_i, double p_j,
                     double c_i, double c_j, int pressure_term, int limited) {
-  double uL = -sph_vec3_dot(vi, e), uR = -sph_vec3_dot(vj, e);
-  double zL = rho_i * c_i, zR = rho_j * c_j, inv = 1.0 / (zL + zR);
-  double jump = uL - uR;
-  double beta = 1.0;
-  if (limited) {
-    beta = 3.0 * jump * 2.0 / (c_i + c_j);
-    beta = beta < 0.0 ? 0.0 : (beta > 1.0 ? 1.0 : beta);
-  }
   ul_riemann s;
-  s.du = (zR * jump - (pressure_term ? p_i - p_j : 0.0)) * inv;
-  s.pstar = (zL * p_j + zR * p_i + beta * zL * zR * jump) * inv;
+  s.du = ul_sph_iact_riemann_du(e, vi, vj, rho_i, rho_j, p_i, p_j, c_i, c_j,
+                                pressure_term);
+  s.pstar = ul_sph_iact_riemann_pstar(e, vi, vj, rho_i, rho_j, p_i, p_j, c_i,
+                                      c_j, limited);
   return s;
 }
 
@@ -103,19 +126,18 @@ static inline void ul_sph_iact_moment(double M[9], double Vj, double r,
       M[3 * a + b] += s * e[a] * e[b];
 }
 
-/* eq. 18 / eq. 30: L_i += V_j (v_i - v_j) (x) (B_i grad_i W); with B = M^-1
- * this is exact for a linear field (B = -I for eq. 18's sign) */
+/* eq. 18 (eq. 30 before the correction B): L_i -= V_j (v_i - v_j) (x)
+ * grad_i W; with B = M^-1 applied on the right, -L B is exact for a linear
+ * field */
 static inline void ul_sph_iact_velocity_gradient(double L[9], double Vj,
                                                  const double vi[3],
-                                                 const double vj[3],
-                                                 const double B[9], double dW,
+                                                 const double vj[3], double dW,
                                                  const double e[3]) {
-  double g[3] = {dW * e[0], dW * e[1], dW * e[2]}, Bg[3];
-  sph_mat3_vec(B, g, Bg);
+  double g[3] = {-(dW * e[0]), -(dW * e[1]), -(dW * e[2])};
   for (int a = 0; a < 3; ++a) {
     double d = Vj * (vi[a] - vj[a]);
     for (int b = 0; b < 3; ++b)
-      L[3 * a + b] += d * Bg[b];
+      L[3 * a + b] += d * g[b];
   }
 }
 
