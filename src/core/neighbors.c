@@ -34,6 +34,21 @@ static int cmp_int32(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+/* ascending; insertion sort for the usual list of tens of entries */
+static void sort_list(int32_t *v, size_t k) {
+  if (k > 256) {
+    qsort(v, k, sizeof *v, cmp_int32);
+    return;
+  }
+  for (size_t i = 1; i < k; ++i) {
+    int32_t x = v[i];
+    size_t j = i;
+    for (; j > 0 && v[j - 1] > x; --j)
+      v[j] = v[j - 1];
+    v[j] = x;
+  }
+}
+
 static sph_status grow(void **p, size_t *cap, size_t need, size_t elem,
                        sph_error *err, const char *what) {
   if (need <= *cap && *p)
@@ -258,7 +273,7 @@ sph_status sph_neighbors_build(sph_neighbors *nl, const double *x, size_t n,
   for (long a = 0; a < nn; ++a) {
     int32_t *list = nl->index + nl->offset[a];
     size_t k = scan(nl, &g, x, (size_t)a, dim, r2, body, filter, list);
-    qsort(list, k, sizeof *list, cmp_int32);
+    sort_list(list, k);
   }
   return SPH_OK;
 }

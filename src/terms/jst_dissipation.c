@@ -15,28 +15,30 @@ typedef struct jst {
   double *d;  /* D(u) */
 } jst;
 
-/* L[u]_a = sum_b (V_b Lap W~_b(X_a)) (u_b - u_a), one loop per component
+/* out_a = cs self_a + cl L[u]_a with L[u]_a = sum_b (V_b Lap W~_b(X_a))
+ * (u_b - u_a) (self may be NULL when cs = 0), one loop per component
  * count so that the compiler sees it */
-static void laplacian3(const jst *j, const double *u, double *out, long n) {
+static void laplacian3(const jst *j, const double *u, const double *self,
+                       double cs, double cl, double *out, long n) {
   const sph_neighbors *nl = j->p.nl;
   const double *wl = j->p.lap;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    double s[3] = {0.0, 0.0, 0.0};
     const double *ua = u + 3 * a;
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       const double *ub = u + 3 * (size_t)nl->index[k];
-      s0 += wl[k] * (ub[0] - ua[0]);
-      s1 += wl[k] * (ub[1] - ua[1]);
-      s2 += wl[k] * (ub[2] - ua[2]);
+      s[0] += wl[k] * (ub[0] - ua[0]);
+      s[1] += wl[k] * (ub[1] - ua[1]);
+      s[2] += wl[k] * (ub[2] - ua[2]);
     }
-    out[3 * a] = s0;
-    out[3 * a + 1] = s1;
-    out[3 * a + 2] = s2;
+    for (int c = 0; c < 3; ++c)
+      out[3 * a + c] = self ? cs * self[3 * a + c] + cl * s[c] : cl * s[c];
   }
 }
 
-static void laplacian1(const jst *j, const double *u, double *out, long n) {
+static void laplacian1(const jst *j, const double *u, const double *self,
+                       double cs, double cl, double *out, long n) {
   const sph_neighbors *nl = j->p.nl;
   const double *wl = j->p.lap;
 #pragma omp parallel for schedule(static)
@@ -44,15 +46,16 @@ static void laplacian1(const jst *j, const double *u, double *out, long n) {
     double s = 0.0;
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k)
       s += wl[k] * (u[nl->index[k]] - u[a]);
-    out[a] = s;
+    out[a] = self ? cs * self[a] + cl * s : cl * s;
   }
 }
 
-static void laplacian(const jst *j, const double *u, double *out, long n) {
+static void laplacian(const jst *j, const double *u, const double *self,
+                      double cs, double cl, double *out, long n) {
   if (j->p.ncomp == 3)
-    laplacian3(j, u, out, n);
+    laplacian3(j, u, self, cs, cl, out, n);
   else
-    laplacian1(j, u, out, n);
+    laplacian1(j, u, self, cs, cl, out, n);
 }
 
 static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
@@ -66,17 +69,21 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   double *rate = nc == 3 ? stage->dp : stage->dJ;
   double c2 = j->p.eps2 * j->p.cp * j->p.h;
   double c4 = j->p.eps4 * j->p.cp * j->p.h * j->p.h * j->p.h;
-  laplacian(j, u, j->lu, n);
+  laplacian(j, u, NULL, 0.0, 1.0, j->lu, n);
   if (sim->mirror) { /* the images' Laplacians mirror their sources' */
     if (nc == 3)
       sph_mirror_vector(sim->mirror, j->lu);
     else
       sph_mirror_scalar(sim->mirror, j->lu, 0.0);
   }
-  if (c4 != 0.0)
-    laplacian(j, j->lu, j->d, n); /* L[L[u]] */
-  for (long i = 0; i < nc * n; ++i)
-    j->d[i] = c2 * j->lu[i] - (c4 != 0.0 ? c4 * j->d[i] : 0.0);
+  long len = nc * n;
+  if (c4 != 0.0) { /* D = c2 L[u] - c4 L[L[u]] */
+    laplacian(j, j->lu, j->lu, c2, -c4, j->d, n);
+  } else {
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < len; ++i)
+      j->d[i] = c2 * j->lu[i];
+  }
   if (j->p.project) {
     if (nc == 3) {
       sph_momentum_projection(ps->n, ps->field[SPH_FIELD_VOLUME0],
@@ -97,7 +104,8 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
       }
     }
   }
-  for (long i = 0; i < nc * n; ++i)
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < len; ++i)
     rate[i] += j->d[i];
   return SPH_OK;
 }
