@@ -32,6 +32,7 @@ typedef struct tl_reference {
   sph_mirror mirror;
   int32_t *src;
   signed char *vsign, *rsign, *ssign;
+  double *vmat; /* 9 per point with an oblique plane (sph_mirror), or NULL */
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as
@@ -49,7 +50,8 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
                               double **out, sph_error *err);
 
 /* Sets the images' state from their sources: positions, momenta, F (and H
- * when not NULL) as I + sigma R (A - I) R, J as 1 + sigma (J - 1). */
+ * when not NULL) as I + sigma R (A - I) R^T, J as 1 + sigma (J - 1), with R
+ * the composed reflection (sign flips across coordinate planes). */
 void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
                        double *H, double *J);
 

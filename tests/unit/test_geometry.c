@@ -48,7 +48,7 @@ static sph_body round_body(sph_shape_kind kind, double dp) {
   b.shape.radius = 0.04;
   b.shape.inner_radius = 0.02;
   b.shape.outer_radius = 0.04;
-  b.shape.axis = 2;
+  b.shape.axis[2] = 1.0;
   b.shape.length = 0.05;
   b.spacing = dp;
   b.seed = 1;
@@ -286,7 +286,7 @@ START_TEST(distances_bounds_and_measures) {
   s.kind = SPH_SHAPE_CYLINDER;
   s.radius = 1.0;
   s.length = 2.0;
-  s.axis = 1;
+  s.axis[1] = 1.0;
   check_distance(&s, 3, 0.0, 1.0, 0.0, -1.0);
   check_distance(&s, 3, 0.0, 0.25, 0.0, -0.25);
   check_distance(&s, 3, 0.6, 1.0, 0.8, 0.0);
@@ -301,7 +301,8 @@ START_TEST(distances_bounds_and_measures) {
   /* 3D ring: a tube of radii 0.5, 1 along x from x = 1, length 3 */
   s.kind = SPH_SHAPE_RING;
   s.center[0] = 1.0;
-  s.axis = 0;
+  s.axis[0] = 1.0;
+  s.axis[1] = 0.0;
   s.length = 3.0;
   s.inner_radius = 0.5;
   s.outer_radius = 1.0;
