@@ -292,9 +292,18 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
     ref->mat[a] = &s->materials[s->bodies[ref->body[a]].material];
     ref->rho0[a] = ref->mat[a]->density;
   }
+  int placed = 0;
   for (size_t b = 0; b < s->nbodies; ++b) {
     double c = sph_material_wave_speed(&s->materials[s->bodies[b].material]);
     ref->cp = c > ref->cp ? c : ref->cp;
+    placed |= s->bodies[b].transform.given;
+  }
+  /* the material axes of placed bodies turn with them */
+  if (placed && !(ref->axes = malloc((n ? n : 1) * sizeof *ref->axes)))
+    return sph_error_set(err, SPH_ERR_NOMEM, "materials");
+  for (size_t a = 0; placed && a < n; ++a) {
+    const sph_transform *T = &s->bodies[ref->body[a]].transform;
+    ref->axes[a] = T->given ? T->R : NULL;
   }
 
   /* state and output fields */
@@ -384,6 +393,7 @@ void tl_reference_destroy(tl_reference *ref) {
   free(ref->rsign);
   free(ref->ssign);
   free(ref->vmat);
+  free(ref->axes);
   if (ref->owns_state) {
     free(ref->x);
     free(ref->p);
@@ -539,7 +549,16 @@ double tl_max_wave_speed(const tl_reference *ref, const double *F) {
   for (long a = 0; a < n; ++a) {
     const double *Fa = F + 9 * a;
     const sph_material *m = ref->mat[a];
-    double Q[27];
+    double Q[27], Fb[9], T[9];
+    if (ref->axes && ref->axes[a]) { /* F in the body frame: R^T F R */
+      const double *R = ref->axes[a];
+      sph_mat3_mul(Fa, R, T);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          Fb[3 * i + j] =
+              R[i] * T[j] + R[3 + i] * T[3 + j] + R[6 + i] * T[6 + j];
+      Fa = Fb;
+    }
     sph_material_acoustic_tensors(m, Fa, Q);
     for (int d = 0; d < 3; ++d) {
       double c2 = sym3_max_eigenvalue(Q + 9 * d) / m->density;

@@ -24,6 +24,8 @@ typedef struct tl_reference {
   const sph_material **mat; /* per point (n_ext) */
   double *rho0;             /* per point (n_ext) */
   double cp;                /* largest p-wave speed of the materials */
+  const double **axes; /* per real point its body's rotation (material axes),
+                          NULL when no body is placed or for unplaced ones */
   /* state, n_ext entries each; the particle fields themselves when there
    * are no images */
   double *x, *p, *F, *J, *P;
@@ -65,8 +67,10 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
 /* Largest p-wave speed of the current state (seed 000 eq. 44, "c_p from
  * the current state"): for each particle the largest eigenvalue of the
  * acoustic tensor Q_ik(N) = dP_iJ/dF_kL N_J N_L along the three material
- * axes, with dP/dF by finite differences of the material's stress at
- * (F, cof F, det F); at F = I it is the linear p-wave speed. */
+ * axes (those of the body frame: F is turned back by a placed body's
+ * rotation, so dt does not depend on the orientation), with dP/dF by finite
+ * differences of the material's stress at (F, cof F, det F); at F = I it is the
+ * linear p-wave speed. */
 double tl_max_wave_speed(const tl_reference *ref, const double *F);
 
 /* Time step of seed 000 eq. 44: cfl h_min / c_p with c_p the larger of the
