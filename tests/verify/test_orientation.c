@@ -14,13 +14,13 @@
  * 1e-10. Anything placed wrongly (a velocity not turned, a normal left
  * along its axis, a time step that depends on the orientation) differs by
  * 1e-6 or more. */
+#include "test_scene_util.h"
 #include "test_util.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "sph/scene.h"
 #include "sph/sim.h"
@@ -76,20 +76,6 @@ static sph_scene *load_file(const char *name, const char *const *sets,
   sph_error err;
   ck_assert_msg(sph_scene_load(&s, path, sets, n, &err) == SPH_OK, "%s",
                 err.message);
-  return s;
-}
-
-static sph_scene *load_text(const char *text) {
-  char path[64] = "/tmp/sph_orient_XXXXXX";
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  sph_scene *s;
-  sph_error err;
-  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
-  unlink(path);
-  ck_assert_msg(st == SPH_OK, "%s", err.message);
   return s;
 }
 
@@ -237,7 +223,7 @@ static sph_scene *mirror_scene(int half, int skew, const char *transform) {
                  "body: cube}}, skew_symmetry: {axis: x}}\n"
                : "boundaries:\n  - {name: m, select: {plane: {axis: x, at: 0, "
                  "body: cube}}, symmetry: {axis: x}}\n");
-  return load_text(text);
+  return sph_test_scene_text(text);
 }
 
 static diff half_vs_full(int skew, const char *transform) {
