@@ -3,7 +3,9 @@
  * neighbour lists and corrected gradients are computed once here, including
  * mirror images across symmetry (normal component negated) and
  * skew-symmetry (tangential components negated) planes, as BENCHMARKS.md
- * D.1 recommends for the swinging cube of seed 000 sec. 8.2. */
+ * D.1 recommends for the swinging cube of seed 000 sec. 8.2; a plane of any
+ * unit normal n reflects X - 2((X - p) . n) n, vectors by R = I - 2 n n^T
+ * and two-point tensors R A R^T (sign flips for coordinate planes). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -2,7 +2,10 @@
  * typed and defaulted, with errors at the file, line, column and key; and
  * the particles the bodies make, with the checks that need them (empty or
  * overlapping bodies, selections that select nothing, probes outside every
- * body). The method and reference blocks are left to their users. */
+ * body). Axes and normals are x, y, z or any vector; a body may be placed
+ * by a rotation (Rodrigues' formula) and a translation, its shape, initial
+ * velocity and own selections being given in its frame. The method and
+ * reference blocks are left to their users. */
 #include "sph/scene.h"
 
 #include <ctype.h>
