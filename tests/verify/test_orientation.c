@@ -2,7 +2,8 @@
  * normals, oblique mirror planes): the shipped spinning cube (B2, seed 000
  * sec. 8.3) and cable (B3, seed 000 sec. 8.1) run as they are and turned
  * by 37 degrees about [1, 2, 3] give the same energy, |linear momentum|,
- * |angular momentum| and wave arrival histories; a half cube with a
+ * |angular momentum| and wave arrival histories, as does the 2D tensile
+ * plate (B11, ul-sph) turned by 30 degrees; a half cube with a
  * symmetry or skew-symmetry mirror plane (BENCHMARKS D.1) gives half the
  * energy of the full cube, with the plane along x and with the same plane
  * turned oblique.
@@ -190,6 +191,28 @@ START_TEST(cable_turned) {
 }
 END_TEST
 
+START_TEST(plate_2d_turned) {
+  /* ul-sph in 2D: the B11 tensile plate turned by 30 degrees about z */
+  const char *sets[] = {"time.end=0.002",
+                        "boundaries.0.select.plane.body=plate",
+                        "bodies.0.transform={rotate: {angle: 30}}"};
+  static history a, b;
+  sph_scene *s0 = load_file("tensile_plate_2d", sets, 2);
+  sph_scene *s1 = load_file("tensile_plate_2d", sets, 3);
+  record(s0, 21, 0.0001, 0, NULL, &a);
+  record(s1, 21, 0.0001, 0, NULL, &b);
+  diff d = compare(&a, &b, 1.0, 1.0);
+  printf("B11 2D turned 30 deg, to 0.002 s: energy %.3g, |p| %.3g, |L| %.3g "
+         "(relative)\n",
+         d.energy, d.lin, d.ang);
+  ck_assert_msg(d.energy <= ROUNDOFF, "energy differs by %g", d.energy);
+  ck_assert_msg(d.lin <= ROUNDOFF, "|p| differs by %g", d.lin);
+  ck_assert_msg(d.ang <= ROUNDOFF, "|L| differs by %g", d.ang);
+  sph_scene_destroy(s0);
+  sph_scene_destroy(s1);
+}
+END_TEST
+
 /* A cube [-0.5, 0.5]^3, or its half x >= 0 with a mirror plane at x = 0 (in
  * the body frame), optionally turned; the velocity field is symmetric
  * (skew = 0) or skew-symmetric (skew = 1) about that plane. Skew images
@@ -262,6 +285,7 @@ int main(void) {
   tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
   tcase_add_test(tc, spinning_cube_turned);
   tcase_add_test(tc, cable_turned);
+  tcase_add_test(tc, plate_2d_turned);
   tcase_add_test(tc, half_body_with_mirror_plane);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
