@@ -247,8 +247,10 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
     return png_error(cam, err, msg);
   }
   /* an eye inside a body would see the particles from within */
-  for (size_t b = 0; s->dimension == 3 && b < s->nbodies; ++b)
-    if (sph_shape_distance(&s->bodies[b].shape, 3, v.eye) < 0.0) {
+  for (size_t b = 0; s->dimension == 3 && b < s->nbodies; ++b) {
+    double eye[3];
+    sph_body_local(&s->bodies[b], v.eye, eye);
+    if (sph_shape_distance(&s->bodies[b].shape, 3, eye) < 0.0) {
       const sph_node *pos = cam ? sph_node_child(cam, "position") : NULL;
       snprintf(msg, sizeof msg,
                "the camera at (%g, %g, %g) is inside body '%s'; place it "
@@ -256,6 +258,7 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
                v.eye[0], v.eye[1], v.eye[2], s->bodies[b].name);
       return png_error(pos ? pos : cam, err, msg);
     }
+  }
   /* something left after the cutaways, and something of it in view */
   unsigned char *keep = malloc(ps->n ? ps->n : 1);
   if (!keep)

@@ -20,7 +20,8 @@ void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]);
 /* Exact area (2D) or volume (3D) of the shape. */
 double sph_shape_measure(const sph_shape *s, int dim);
 
-/* Particles of one body: *x (3 per particle) and *v (volumes), malloc'd,
+/* Particles of one body in its own frame (the scene applies the body's
+ * transform): *x (3 per particle) and *v (volumes), malloc'd,
  * *n of them. Deterministic for a given body (seeded RNG). */
 sph_status sph_body_generate(const sph_body *b, int dim, double **x,
                              double **volume, size_t *n, sph_error *err);

@@ -32,7 +32,7 @@ typedef struct sph_shape {
   sph_shape_kind kind;
   double min[3], max[3]; /* box */
   double center[3];
-  int axis; /* 0, 1, 2 = x, y, z */
+  double axis[3]; /* unit vector (cylinder, tube) */
   double radius, inner_radius, outer_radius, length;
 } sph_shape;
 
@@ -62,17 +62,27 @@ typedef struct sph_expr sph_expr; /* see expr.h */
 typedef struct sph_velocity {
   sph_velocity_kind kind;
   double value[3];
-  int axis;
+  double axis[3]; /* unit vector */
   double omega;
   double center[3];
   sph_expr *profile; /* rotation profile, NULL = 1 */
   sph_expr *expr[3]; /* expression components */
 } sph_velocity;
 
+/* Rigid placement of a body: world X = R X_body + t. The body's shape,
+ * initial velocity field and the selections that name it (with the normals
+ * and velocities of their boundaries) are given in the body frame. */
+typedef struct sph_transform {
+  int given;   /* 0: the identity */
+  double R[9]; /* rotation, row-major */
+  double t[3];
+} sph_transform;
+
 typedef struct sph_body {
   char name[SPH_NAME_MAX];
   int material; /* index into scene->materials */
   sph_shape shape;
+  sph_transform transform;
   sph_lattice lattice;
   int count[3];   /* SPH_LATTICE_FACES */
   double spacing; /* dp (derived from count for FACES: the smallest L/(n-1)) */
@@ -85,14 +95,17 @@ typedef struct sph_body {
 } sph_body;
 
 typedef enum sph_select_kind {
-  SPH_SELECT_PLANE, /* |X_axis - at| <= tolerance */
-  SPH_SELECT_BOX,   /* min <= X <= max (inclusive, with tolerance) */
-  SPH_SELECT_FACE   /* the side of a body's bounding box: body, axis, sign */
+  SPH_SELECT_PLANE, /* |X . normal - at| <= tolerance (world frame) */
+  SPH_SELECT_BOX,   /* min <= X <= max (inclusive, with tolerance; in the
+                       frame of `body` when it names one) */
+  SPH_SELECT_FACE   /* the side of a body's bounding box in its frame: body,
+                       axis, sign */
 } sph_select_kind;
 
 typedef struct sph_selection {
   sph_select_kind kind;
-  int axis;
+  int axis;         /* FACE; PLANE: the coordinate axis of normal, or -1 */
+  double normal[3]; /* PLANE: unit normal */
   double at;
   double tolerance; /* default: half the body spacing */
   double min[3], max[3];
@@ -114,9 +127,10 @@ typedef struct sph_boundary {
   char name[SPH_NAME_MAX];
   sph_selection select;
   sph_condition_kind kind;
-  int axis;        /* roller / symmetry plane normal */
-  double value[3]; /* prescribed velocity */
-  unsigned mask;   /* components prescribed (bits 0..2) */
+  double normal[3]; /* roller / symmetry plane unit normal (world frame) */
+  int axis;         /* the coordinate axis of normal, or -1 (oblique) */
+  double value[3];  /* prescribed velocity (world frame) */
+  unsigned mask;    /* components prescribed (bits 0..2) */
   double from, until;
   int line, col;
 } sph_boundary;
@@ -220,6 +234,13 @@ double sph_scene_min_spacing(const sph_scene *s);
 /* Index of the named material/body, or -1. */
 int sph_scene_find_material(const sph_scene *s, const char *name);
 int sph_scene_find_body(const sph_scene *s, const char *name);
+
+/* Position X (world frame) in the frame of body `body`, and back. */
+void sph_body_local(const sph_body *b, const double X[3], double Xb[3]);
+void sph_body_world(const sph_body *b, const double Xb[3], double X[3]);
+
+/* The coordinate axis (0, 1, 2) the unit vector n is, or -1. */
+int sph_axis_index(const double n[3]);
 
 /* Whether boundary `b` selects the particle at reference position X of body
  * `body`. */

@@ -95,13 +95,16 @@ typedef struct sph_timer {
 
 /* Mirror (ghost) images of real particles across symmetry planes (seed 000
  * sec. 8.2, BENCHMARKS D.1): particle n_real + g is the image of src[g].
- * A vector of the image is S v with S = diag(vsign[3g..3g+2]); a scalar's
- * departure from its reference value flips by ssign[g]. Terms that read
- * neighbours' values refresh images with sph_mirror_vector/scalar. */
+ * A vector of the image is S v with S = diag(vsign[3g..3g+2]) when every
+ * plane is a coordinate plane, else S = vmat[9g..9g+8] (row-major: sigma
+ * times the composed reflections I - 2 n n^T); a scalar's departure from its
+ * reference value flips by ssign[g] (sigma). Terms that read neighbours'
+ * values refresh images with sph_mirror_vector/scalar. */
 typedef struct sph_mirror {
   size_t n_real, n_ghost;
   const int32_t *src;
   const signed char *vsign;
+  const double *vmat; /* NULL: coordinate planes only */
   const signed char *ssign;
 } sph_mirror;
 

@@ -128,6 +128,10 @@ static sph_status swinging_cube_create(sph_reference *r, const sph_scene *s,
   if (s->dimension != 3 || s->nbodies != 1)
     return sph_node_error(n, err, SPH_ERR_ARG,
                           "swinging_cube needs one body in 3D");
+  if (s->bodies[0].transform.given)
+    return sph_node_error(n, err, SPH_ERR_ARG,
+                          "swinging_cube is given in the world frame: the "
+                          "body cannot have a transform");
   SPH_TRY(sph_node_get_double(n, "U0", 0, 5e-4, &r->U0, err));
   static const char *const amp[] = {"A", "B", "C"};
   for (int i = 0; i < 3; ++i)

@@ -178,6 +178,17 @@ void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]) {
 
 void sph_mirror_vector(const sph_mirror *m, double *v) {
   long ng = (long)m->n_ghost;
+  if (m->vmat) {
+#pragma omp parallel for schedule(static)
+    for (long g = 0; g < ng; ++g) {
+      size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;
+      const double *M = m->vmat + 9 * g;
+      for (int c = 0; c < 3; ++c)
+        v[3 * d + c] = M[3 * c] * v[3 * s] + M[3 * c + 1] * v[3 * s + 1] +
+                       M[3 * c + 2] * v[3 * s + 2];
+    }
+    return;
+  }
 #pragma omp parallel for schedule(static)
   for (long g = 0; g < ng; ++g) {
     size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;

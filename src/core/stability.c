@@ -46,7 +46,8 @@ void sph_lattice_parity(const sph_scene *s, const sph_particles *ps,
                         signed char *parity) {
   for (size_t a = 0; a < ps->n; ++a) {
     const sph_body *b = &s->bodies[ps->body[a]];
-    const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+    double X[3];
+    sph_body_local(b, ps->field[SPH_FIELD_POSITION0] + 3 * a, X);
     parity[a] = 0;
     if (b->distribution == SPH_DIST_RELAX)
       continue;

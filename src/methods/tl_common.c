@@ -3,7 +3,9 @@
  * neighbour lists and corrected gradients are computed once here, including
  * mirror images across symmetry (normal component negated) and
  * skew-symmetry (tangential components negated) planes, as BENCHMARKS.md
- * D.1 recommends for the swinging cube of seed 000 sec. 8.2. */
+ * D.1 recommends for the swinging cube of seed 000 sec. 8.2; a plane of any
+ * unit normal n reflects X - 2((X - p) . n) n, vectors by R = I - 2 n n^T
+ * and two-point tensors R A R^T (sign flips for coordinate planes). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,8 +19,9 @@
  * ------------------------------------------------------------ */
 
 typedef struct plane {
-  int axis, side, body;
-  double at;
+  double n[3], at; /* X . n = at */
+  int axis;        /* n is this coordinate axis, or -1 (oblique) */
+  int side, body;
   int sigma; /* +1 symmetry, -1 skew-symmetry */
   size_t done;
 } plane;
@@ -52,10 +55,16 @@ static int hash_insert(hash *h, const int64_t k[3]) {
 }
 
 static sph_status grow_points(tl_reference *r, size_t need, size_t *cap,
-                              sph_error *err) {
+                              int oblique, sph_error *err) {
   if (need <= *cap)
     return SPH_OK;
   size_t c = 2 * need;
+  if (oblique) {
+    double *M = realloc(r->vmat, 9 * c * sizeof *M);
+    if (!M)
+      return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+    r->vmat = M;
+  }
   double *X = realloc(r->X, 3 * c * sizeof *X), *V;
   if (X)
     r->X = X;
@@ -83,18 +92,49 @@ static sph_status grow_points(tl_reference *r, size_t need, size_t *cap,
   return SPH_OK;
 }
 
+/* Signed distance of X from the plane (exact for a coordinate axis). */
+static inline double plane_distance(const plane *pl, const double *X) {
+  if (pl->axis >= 0)
+    return X[pl->axis] - pl->at;
+  return X[0] * pl->n[0] + X[1] * pl->n[1] + X[2] * pl->n[2] - pl->at;
+}
+
 /* Real points first, then images of every point within two supports of a
  * plane on its domain side; two passes over the planes complete edges,
- * corners and periodic images, duplicates are skipped. */
+ * corners and periodic images, duplicates are skipped. Images across
+ * coordinate planes flip signs; with an oblique plane every point carries
+ * its reflection as a matrix (chosen once here). */
 static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
                                sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_particles *ps = sim->ps;
+  const double *X0 = ps->field[SPH_FIELD_POSITION0];
   size_t n = ps->n, cap = 0;
   plane planes[32];
-  int np = 0;
-  SPH_TRY(grow_points(r, n + 1, &cap, err));
-  memcpy(r->X, ps->field[SPH_FIELD_POSITION0], 3 * n * sizeof(double));
+  int np = 0, oblique = 0;
+  for (size_t k = 0; images && k < s->nboundaries && np < 32; ++k) {
+    const sph_boundary *bc = &s->boundaries[k];
+    if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
+      continue;
+    plane *pl = &planes[np++];
+    memcpy(pl->n, bc->select.normal, sizeof pl->n);
+    pl->axis = bc->select.axis;
+    pl->at = bc->select.at;
+    pl->body = bc->select.body;
+    pl->sigma = bc->kind == SPH_BC_SYMMETRY ? 1 : -1;
+    pl->done = 0;
+    oblique |= pl->axis < 0;
+    double mean = 0.0;
+    size_t cnt = 0;
+    for (size_t a = 0; a < n; ++a)
+      if (pl->body < 0 || ps->body[a] == pl->body) {
+        mean += plane_distance(pl, X0 + 3 * a);
+        ++cnt;
+      }
+    pl->side = cnt && mean / (double)cnt < 0.0 ? -1 : 1;
+  }
+  SPH_TRY(grow_points(r, n + 1, &cap, oblique, err));
+  memcpy(r->X, X0, 3 * n * sizeof(double));
   memcpy(r->V, ps->field[SPH_FIELD_VOLUME0], n * sizeof(double));
   memcpy(r->body, ps->body, n * sizeof(int32_t));
   for (size_t a = 0; a < n; ++a) {
@@ -102,25 +142,8 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     memset(r->vsign + 3 * a, 1, 3);
     memset(r->rsign + 3 * a, 1, 3);
     r->ssign[a] = 1;
-  }
-  for (size_t k = 0; images && k < s->nboundaries && np < 32; ++k) {
-    const sph_boundary *bc = &s->boundaries[k];
-    if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
-      continue;
-    plane *pl = &planes[np++];
-    pl->axis = bc->select.axis;
-    pl->at = bc->select.at;
-    pl->body = bc->select.body;
-    pl->sigma = bc->kind == SPH_BC_SYMMETRY ? 1 : -1;
-    pl->done = 0;
-    double mean = 0.0;
-    size_t cnt = 0;
-    for (size_t a = 0; a < n; ++a)
-      if (pl->body < 0 || ps->body[a] == pl->body) {
-        mean += r->X[3 * a + pl->axis];
-        ++cnt;
-      }
-    pl->side = cnt && mean / (double)cnt < pl->at ? -1 : 1;
+    if (oblique)
+      sph_mat3_identity(r->vmat + 9 * a);
   }
   size_t total = n;
   if (np) {
@@ -149,11 +172,15 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
         for (size_t i = pl->done; i < count && st == SPH_OK; ++i) {
           if (pl->body >= 0 && r->body[i] != pl->body)
             continue;
-          double d = (r->X[3 * i + pl->axis] - pl->at) * pl->side;
+          double dist = plane_distance(pl, r->X + 3 * i), d = dist * pl->side;
           if (d <= 0.0 || d >= layer)
             continue;
           double Xn[3] = {r->X[3 * i], r->X[3 * i + 1], r->X[3 * i + 2]};
-          Xn[pl->axis] = 2.0 * pl->at - Xn[pl->axis];
+          if (pl->axis >= 0)
+            Xn[pl->axis] = 2.0 * pl->at - Xn[pl->axis];
+          else
+            for (int c = 0; c < 3; ++c)
+              Xn[c] -= 2.0 * dist * pl->n[c];
           int64_t key[3];
           for (int c = 0; c < 3; ++c)
             key[c] = llround(Xn[c] / q);
@@ -162,7 +189,7 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
             full = 1;
           if (ins <= 0)
             continue;
-          if ((st = grow_points(r, total + 1, &cap, err)) != SPH_OK)
+          if ((st = grow_points(r, total + 1, &cap, oblique, err)) != SPH_OK)
             break;
           memcpy(r->X + 3 * total, Xn, sizeof Xn);
           r->V[total] = r->V[i];
@@ -175,6 +202,16 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
             r->vsign[3 * total + c] =
                 (signed char)(r->ssign[total] * r->rsign[3 * total + c]);
           }
+          /* vmat of the image: sigma (I - 2 n n^T) vmat of its source */
+          for (int a = 0; oblique && a < 3; ++a)
+            for (int b = 0; b < 3; ++b) {
+              const double *M = r->vmat + 9 * i;
+              double m =
+                  M[3 * a + b] - 2.0 * pl->n[a] *
+                                     (pl->n[0] * M[b] + pl->n[1] * M[3 + b] +
+                                      pl->n[2] * M[6 + b]);
+              r->vmat[9 * total + 3 * a + b] = pl->sigma * m;
+            }
           ++total;
         }
         pl->done = count;
@@ -192,6 +229,7 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
                            .n_ghost = total - n,
                            .src = r->src + n,
                            .vsign = r->vsign + 3 * n,
+                           .vmat = oblique ? r->vmat + 9 * n : NULL,
                            .ssign = r->ssign + n};
   return SPH_OK;
 }
@@ -312,9 +350,18 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
     ref->mat[a] = &s->materials[s->bodies[ref->body[a]].material];
     ref->rho0[a] = ref->mat[a]->density;
   }
+  int placed = 0;
   for (size_t b = 0; b < s->nbodies; ++b) {
     double c = sph_material_wave_speed(&s->materials[s->bodies[b].material]);
     ref->cp = c > ref->cp ? c : ref->cp;
+    placed |= s->bodies[b].transform.given;
+  }
+  /* the material axes of placed bodies turn with them */
+  if (placed && !(ref->axes = malloc((n ? n : 1) * sizeof *ref->axes)))
+    return sph_error_set(err, SPH_ERR_NOMEM, "materials");
+  for (size_t a = 0; placed && a < n; ++a) {
+    const sph_transform *T = &s->bodies[ref->body[a]].transform;
+    ref->axes[a] = T->given ? T->R : NULL;
   }
 
   /* state and output fields */
@@ -413,6 +460,8 @@ void tl_reference_destroy(tl_reference *ref) {
   free(ref->vsign);
   free(ref->rsign);
   free(ref->ssign);
+  free(ref->vmat);
+  free(ref->axes);
   if (ref->owns_state) {
     free(ref->x);
     free(ref->p);
@@ -432,8 +481,55 @@ static inline void mirror_tensor(const double *A, double *out, int sigma,
           (i == j) + sigma * R[i] * R[j] * (A[3 * i + j] - (i == j));
 }
 
+/* image of a two-point tensor across oblique planes: I + sigma M (A - I) M^T
+ * with M = vmat (sigma^2 = 1 makes it Q (A - I) Q^T for the reflection Q) */
+static inline void mirror_tensor_oblique(const double *A, double *out,
+                                         int sigma, const double *M) {
+  double B[9], T[9];
+  memcpy(B, A, sizeof B);
+  B[0] -= 1.0, B[4] -= 1.0, B[8] -= 1.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      T[3 * i + j] = B[3 * i] * M[3 * j] + B[3 * i + 1] * M[3 * j + 1] +
+                     B[3 * i + 2] * M[3 * j + 2];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out[3 * i + j] =
+          (i == j) + sigma * (M[3 * i] * T[j] + M[3 * i + 1] * T[3 + j] +
+                              M[3 * i + 2] * T[6 + j]);
+}
+
+static void mirror_refresh_oblique(const tl_reference *ref, double *x,
+                                   double *p, double *F, double *H, double *J) {
+  long n = (long)ref->n, ne = (long)ref->n_ext;
+#pragma omp parallel for schedule(static)
+  for (long g = n; g < ne; ++g) {
+    size_t s = (size_t)ref->src[g];
+    const double *M = ref->vmat + 9 * g;
+    int sigma = ref->ssign[g];
+    double u[3] = {x[3 * s] - ref->X[3 * s], x[3 * s + 1] - ref->X[3 * s + 1],
+                   x[3 * s + 2] - ref->X[3 * s + 2]};
+    for (int c = 0; c < 3; ++c) {
+      const double *m = M + 3 * c;
+      x[3 * g + c] =
+          ref->X[3 * g + c] + m[0] * u[0] + m[1] * u[1] + m[2] * u[2];
+      p[3 * g + c] =
+          m[0] * p[3 * s] + m[1] * p[3 * s + 1] + m[2] * p[3 * s + 2];
+    }
+    mirror_tensor_oblique(F + 9 * s, F + 9 * g, sigma, M);
+    if (H)
+      mirror_tensor_oblique(H + 9 * s, H + 9 * g, sigma, M);
+    if (J)
+      J[g] = 1.0 + sigma * (J[s] - 1.0);
+  }
+}
+
 void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
                        double *H, double *J) {
+  if (ref->vmat) {
+    mirror_refresh_oblique(ref, x, p, F, H, J);
+    return;
+  }
   long n = (long)ref->n, ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
   for (long g = n; g < ne; ++g) {
@@ -521,7 +617,16 @@ double tl_max_wave_speed(const tl_reference *ref, const double *F) {
   for (long a = 0; a < n; ++a) {
     const double *Fa = F + 9 * a;
     const sph_material *m = ref->mat[a];
-    double Q[27];
+    double Q[27], Fb[9], T[9];
+    if (ref->axes && ref->axes[a]) { /* F in the body frame: R^T F R */
+      const double *R = ref->axes[a];
+      sph_mat3_mul(Fa, R, T);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          Fb[3 * i + j] =
+              R[i] * T[j] + R[3 + i] * T[3 + j] + R[6 + i] * T[6 + j];
+      Fa = Fb;
+    }
     sph_material_acoustic_tensors(m, Fa, Q);
     for (int d = 0; d < 3; ++d) {
       double c2 = sym3_max_eigenvalue(Q + 9 * d) / m->density;

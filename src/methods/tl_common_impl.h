@@ -27,6 +27,8 @@ typedef struct tl_reference {
   const sph_material **mat; /* per point (n_ext) */
   double *rho0;             /* per point (n_ext) */
   double cp;                /* largest p-wave speed of the materials */
+  const double **axes; /* per real point its body's rotation (material axes),
+                          NULL when no body is placed or for unplaced ones */
   /* state, n_ext entries each; the particle fields themselves when there
    * are no images */
   double *x, *p, *F, *J, *P;
@@ -36,6 +38,7 @@ typedef struct tl_reference {
   sph_mirror mirror;
   int32_t *src;
   signed char *vsign, *rsign, *ssign;
+  double *vmat; /* 9 per point with an oblique plane (sph_mirror), or NULL */
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as
@@ -74,7 +77,8 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
                               double **out, sph_error *err);
 
 /* Sets the images' state from their sources: positions, momenta, F (and H
- * when not NULL) as I + sigma R (A - I) R, J as 1 + sigma (J - 1). */
+ * when not NULL) as I + sigma R (A - I) R^T, J as 1 + sigma (J - 1), with R
+ * the composed reflection (sign flips across coordinate planes). */
 void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
                        double *H, double *J);
 
@@ -88,8 +92,10 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
 /* Largest p-wave speed of the current state (seed 000 eq. 44, "c_p from
  * the current state"): for each particle the largest eigenvalue of the
  * acoustic tensor Q_ik(N) = dP_iJ/dF_kL N_J N_L along the three material
- * axes, with dP/dF by finite differences of the material's stress at
- * (F, cof F, det F); at F = I it is the linear p-wave speed. */
+ * axes (those of the body frame: F is turned back by a placed body's
+ * rotation, so dt does not depend on the orientation), with dP/dF by finite
+ * differences of the material's stress at (F, cof F, det F); at F = I it is the
+ * linear p-wave speed. */
 double tl_max_wave_speed(const tl_reference *ref, const double *F);
 
 /* Time step of seed 000 eq. 44: cfl h_min / c_p with c_p the larger of the

@@ -34,12 +34,15 @@ static double combine(double dr, double da) {
   return sqrt(ox * ox + oy * oy) + (inside < 0 ? inside : 0);
 }
 
-/* distance from the axis and coordinate along it from the base centre */
+/* distance from the axis and coordinate along it from the base centre (exact
+ * for a coordinate axis: the other components of a are zero) */
 static void axial_coords(const sph_shape *s, const double X[3], double *rho,
                          double *along) {
+  const double *a = s->axis;
   double d[3] = {X[0] - s->center[0], X[1] - s->center[1], X[2] - s->center[2]};
-  *along = d[s->axis];
-  d[s->axis] = 0.0;
+  *along = d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+  for (int c = 0; c < 3; ++c)
+    d[c] -= *along * a[c];
   *rho = hypot3(d[0], d[1], d[2]);
 }
 
@@ -106,10 +109,14 @@ void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]) {
     lo[c] = s->center[c] - r;
     hi[c] = s->center[c] + r;
   }
-  if (shape_is_axial(s, dim)) {
-    lo[s->axis] = s->center[s->axis];
-    hi[s->axis] = s->center[s->axis] + s->length;
-  }
+  if (shape_is_axial(s, dim))
+    for (int c = 0; c < 3; ++c) {
+      /* the end discs: radius r sqrt(1 - a_c^2) across component c */
+      double end = s->center[c] + s->length * s->axis[c];
+      double across = r * sqrt(fmax(1.0 - s->axis[c] * s->axis[c], 0.0));
+      lo[c] = fmin(s->center[c], end) - across;
+      hi[c] = fmax(s->center[c], end) + across;
+    }
 }
 
 double sph_shape_measure(const sph_shape *s, int dim) {
@@ -157,10 +164,10 @@ static int radial_wall(const double rel[3], double r, double radius, int sign,
   return 1;
 }
 
-static int axial_wall(int axis, double d, int sign, wall *w) {
+static int axial_wall(const double n[3], double d, int sign, wall *w) {
   w->d = d;
-  w->n[0] = w->n[1] = w->n[2] = 0.0;
-  w->n[axis] = sign;
+  for (int c = 0; c < 3; ++c)
+    w->n[c] = sign * n[c];
   return 1;
 }
 
@@ -173,8 +180,9 @@ static int shape_walls(const sph_shape *s, int dim, const double X[3],
   switch (s->kind) {
   case SPH_SHAPE_BOX:
     for (int c = 0; c < dim; ++c) {
-      k += axial_wall(c, s->min[c] - X[c], -1, &w[k]);
-      k += axial_wall(c, X[c] - s->max[c], +1, &w[k]);
+      const double e[3] = {c == 0, c == 1, c == 2};
+      k += axial_wall(e, s->min[c] - X[c], -1, &w[k]);
+      k += axial_wall(e, X[c] - s->max[c], +1, &w[k]);
     }
     return k;
   case SPH_SHAPE_DISC:
@@ -185,8 +193,9 @@ static int shape_walls(const sph_shape *s, int dim, const double X[3],
     int axial = shape_is_axial(s, dim);
     double along = 0.0;
     if (axial) {
-      along = rel[s->axis];
-      rel[s->axis] = 0.0;
+      along = rel[0] * s->axis[0] + rel[1] * s->axis[1] + rel[2] * s->axis[2];
+      for (int c = 0; c < 3; ++c)
+        rel[c] -= along * s->axis[c];
     }
     if (s->kind == SPH_SHAPE_DISC)
       rel[2] = 0.0;
@@ -533,11 +542,13 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
     break;
   }
   if (shape_is_axial(s, dim) &&
-      (s->axis < 0 || s->axis > 2 || !(s->length > 0.0)))
+      (fabs(hypot3(s->axis[0], s->axis[1], s->axis[2]) - 1.0) > 1e-12 ||
+       !(s->length > 0.0)))
     return sph_error_set(err, SPH_ERR_GEOMETRY,
-                         "body '%s': the %s needs an axis 0..2 and a positive "
-                         "length, got axis %d, length %g",
-                         b->name, name, s->axis, s->length);
+                         "body '%s': the %s needs a unit axis and a positive "
+                         "length, got axis (%g, %g, %g), length %g",
+                         b->name, name, s->axis[0], s->axis[1], s->axis[2],
+                         s->length);
   if (b->lattice == SPH_LATTICE_FACES) {
     if (s->kind != SPH_SHAPE_BOX)
       return sph_error_set(err, SPH_ERR_GEOMETRY,

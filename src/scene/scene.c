@@ -2,7 +2,10 @@
  * typed and defaulted, with errors at the file, line, column and key; and
  * the particles the bodies make, with the checks that need them (empty or
  * overlapping bodies, selections that select nothing, probes outside every
- * body). The method and reference blocks are left to their users. */
+ * body). Axes and normals are x, y, z or any vector; a body may be placed
+ * by a rotation (Rodrigues' formula) and a translation, its shape, initial
+ * velocity and own selections being given in its frame. The method and
+ * reference blocks are left to their users. */
 #include "sph/scene.h"
 
 #include <ctype.h>
@@ -49,7 +52,36 @@ static sph_status get_axis(sph_node *map, const char *key, int required,
       return SPH_OK;
     }
   return sph_node_error(sph_node_child(map, key), err, SPH_ERR_RANGE,
-                        "axis must be x, y or z, got '%s'", name);
+                        "%s must be x, y, z or a vector [a, b, c], got '%s'",
+                        key, name);
+}
+
+/* A direction: x, y or z, or a non-zero vector of n numbers (n = 2 leaves
+ * z = 0), scaled to unit length. */
+static sph_status get_direction(sph_node *map, const char *key, int required,
+                                int def, int n, double out[3], sph_error *err) {
+  sph_node *c = sph_node_child(map, key);
+  out[0] = out[1] = out[2] = 0.0;
+  if (!c || c->kind != SPH_NODE_SEQ) {
+    int a = def;
+    SPH_TRY(get_axis(map, key, required, def, &a, err));
+    out[a] = 1.0;
+    return SPH_OK;
+  }
+  SPH_TRY(sph_node_get_doubles(map, key, 1, (size_t)n, out, NULL, err));
+  /* scaled by the largest component first: no underflow of tiny vectors */
+  double big = fmax(fabs(out[0]), fmax(fabs(out[1]), fabs(out[2]))), len = 0;
+  for (int k = 0; big > 0 && isfinite(big) && k < 3; ++k) {
+    out[k] /= big;
+    len += out[k] * out[k];
+  }
+  if (!(len > 0.0))
+    return sph_node_error(c, err, SPH_ERR_RANGE,
+                          "%s must be a non-zero, finite vector", key);
+  len = sqrt(len);
+  for (int k = 0; k < 3; ++k)
+    out[k] /= len;
+  return SPH_OK;
 }
 
 static sph_status positive(sph_node *map, const char *key, int required,
@@ -251,7 +283,7 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                                        NULL};
     SPH_TRY(sph_node_check_keys(g, keys, err));
     SPH_TRY(sph_node_get_doubles(g, "center", 1, 3, sh->center, NULL, err));
-    SPH_TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
+    SPH_TRY(get_direction(g, "axis", 0, 2, 3, sh->axis, err));
     SPH_TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
     if (!(sh->radius > 0))
       return sph_node_error(sph_node_child(g, "radius"), err, SPH_ERR_GEOMETRY,
@@ -285,7 +317,7 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                             "outer_radius, got %g and %g",
                             sh->inner_radius, sh->outer_radius);
     if (tube) {
-      SPH_TRY(get_axis(g, "axis", 0, 2, &sh->axis, err));
+      SPH_TRY(get_direction(g, "axis", 0, 2, 3, sh->axis, err));
       SPH_TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
       if (!(sh->length > 0))
         return sph_node_error(
@@ -409,7 +441,7 @@ static sph_status parse_velocity(sph_scene *s, sph_velocity *v, sph_node *n,
     static const char *const keys[] = {"axis", "omega", "center", "profile",
                                        NULL};
     SPH_TRY(sph_node_check_keys(r, keys, err));
-    SPH_TRY(get_axis(r, "axis", 1, 2, &v->axis, err));
+    SPH_TRY(get_direction(r, "axis", 1, 2, 3, v->axis, err));
     SPH_TRY(sph_node_get_double(r, "omega", 1, 0, &v->omega, err));
     if (sph_node_child(r, "center"))
       SPH_TRY(sph_node_get_doubles(r, "center", 1, 3, v->center, NULL, err));
@@ -436,6 +468,56 @@ static sph_status parse_velocity(sph_scene *s, sph_velocity *v, sph_node *n,
   return SPH_OK;
 }
 
+/* cos and sin of an angle in degrees, exact at multiples of 90 */
+static void cos_sin_degrees(double deg, double *c, double *sn) {
+  double q = fmod(deg, 360.0);
+  q += q < 0.0 ? 360.0 : 0.0;
+  static const double exact[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+  if (fmod(q, 90.0) == 0.0) {
+    *c = exact[(int)(q / 90.0) % 4][0];
+    *sn = exact[(int)(q / 90.0) % 4][1];
+    return;
+  }
+  *c = cos(deg * M_PI / 180.0);
+  *sn = sin(deg * M_PI / 180.0);
+}
+
+/* transform: {rotate: {axis, angle}, translate}; R by Rodrigues' formula
+ * R = cos I + sin [a]x + (1 - cos) a a^T; 2D rotates about z */
+static sph_status parse_transform(sph_scene *s, sph_transform *T, sph_node *n,
+                                  sph_error *err) {
+  static const char *const keys[] = {"rotate", "translate", NULL};
+  SPH_TRY(sph_node_check_keys(n, keys, err));
+  int d = s->dimension;
+  memset(T, 0, sizeof *T);
+  T->given = 1;
+  T->R[0] = T->R[4] = T->R[8] = 1.0;
+  sph_node *r;
+  SPH_TRY(sph_node_get_map(n, "rotate", 0, &r, err));
+  if (r) {
+    static const char *const k3[] = {"axis", "angle", NULL};
+    if (d == 2 && sph_node_child(r, "axis"))
+      return sph_node_error(sph_node_child(r, "axis"), err, SPH_ERR_ARG,
+                            "a 2D rotation is about z: give only the angle");
+    SPH_TRY(sph_node_check_keys(r, k3, err));
+    double a[3] = {0.0, 0.0, 1.0}, deg, c, sn;
+    if (d == 3)
+      SPH_TRY(get_direction(r, "axis", 1, 2, 3, a, err));
+    SPH_TRY(sph_node_get_double(r, "angle", 1, 0, &deg, err));
+    if (!isfinite(deg))
+      return sph_node_error(sph_node_child(r, "angle"), err, SPH_ERR_RANGE,
+                            "the angle (degrees) must be finite");
+    cos_sin_degrees(deg, &c, &sn);
+    const double ax[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        T->R[3 * i + j] =
+            (i == j) * c + sn * ax[3 * i + j] + (1.0 - c) * a[i] * a[j];
+  }
+  SPH_TRY(sph_node_get_doubles(n, "translate", 0, (size_t)d, T->t, NULL, err));
+  return SPH_OK;
+}
+
 static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
   sph_node *list;
   SPH_TRY(get_seq(root, "bodies", 1, &list, err));
@@ -445,8 +527,9 @@ static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
   s->bodies = calloc(list->count, sizeof *s->bodies);
   if (!s->bodies)
     return sph_error_set(err, SPH_ERR_NOMEM, "bodies");
-  static const char *const keys[] = {"name",      "material",         "shape",
-                                     "particles", "initial_velocity", NULL};
+  static const char *const keys[] = {
+      "name",      "material", "shape", "particles", "initial_velocity",
+      "transform", NULL};
   for (size_t i = 0; i < list->count; ++i) {
     sph_node *n = list->items[i];
     sph_body *b = &s->bodies[i];
@@ -486,8 +569,27 @@ static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
     SPH_TRY(sph_node_get_map(n, "initial_velocity", 0, &vel, err));
     if (vel)
       SPH_TRY(parse_velocity(s, &b->velocity, vel, err));
+    sph_node *tr;
+    SPH_TRY(sph_node_get_map(n, "transform", 0, &tr, err));
+    if (tr)
+      SPH_TRY(parse_transform(s, &b->transform, tr, err));
   }
   return SPH_OK;
+}
+
+/* The placement of the body a selection names, or NULL (world frame). */
+static const sph_transform *selection_frame(const sph_scene *s,
+                                            const sph_selection *sel) {
+  if (sel->body < 0 || !s->bodies[sel->body].transform.given)
+    return NULL;
+  return &s->bodies[sel->body].transform;
+}
+
+/* out = R v */
+static void rotate(const sph_transform *T, const double v[3], double out[3]) {
+  for (int i = 0; i < 3; ++i)
+    out[i] =
+        T->R[3 * i] * v[0] + T->R[3 * i + 1] * v[1] + T->R[3 * i + 2] * v[2];
 }
 
 static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
@@ -522,7 +624,7 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
     SPH_TRY(sph_node_check_keys(g, which == 0 ? pkeys : bkeys, err));
     SPH_TRY(sph_node_get_string(g, "body", 0, NULL, &body, err));
     if (which == SPH_SELECT_PLANE) {
-      SPH_TRY(get_axis(g, "axis", 1, 0, &sel->axis, err));
+      SPH_TRY(get_direction(g, "axis", 1, 0, s->dimension, sel->normal, err));
       SPH_TRY(sph_node_get_double(g, "at", 1, 0, &sel->at, err));
       sel->tolerance = -1.0; /* resolved below */
       if (sph_node_child(g, "tolerance"))
@@ -546,6 +648,16 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
       return sph_node_error(sph_node_child(g, "body"), err, SPH_ERR_ARG,
                             "no body named '%s'", body);
   }
+  /* a plane in the frame of a placed body, in the world frame */
+  const sph_transform *T = selection_frame(s, sel);
+  if (sel->kind == SPH_SELECT_PLANE && T) {
+    double w[3];
+    rotate(T, sel->normal, w);
+    memcpy(sel->normal, w, sizeof w);
+    sel->at += w[0] * T->t[0] + w[1] * T->t[1] + w[2] * T->t[2];
+  }
+  if (sel->kind == SPH_SELECT_PLANE)
+    sel->axis = sph_axis_index(sel->normal);
   /* the first particle layer: on the plane for face lattices, half a
    * spacing inside for cell-centred ones (jitter moves it by < dp / 2) */
   double spacing = INFINITY, tol = INFINITY;
@@ -629,8 +741,20 @@ static sph_status parse_boundaries(sph_scene *s, sph_node *root,
                                 "until (%g) must be after from (%g)", b->until,
                                 b->from);
       }
+      const sph_transform *T = selection_frame(s, &b->select);
+      if (T) {
+        double w[3];
+        rotate(T, b->value, w);
+        memcpy(b->value, w, sizeof w);
+      }
       sph_node *comp;
       SPH_TRY(get_seq(v, "components", 0, &comp, err));
+      if (comp && T)
+        return sph_node_error(comp, err, SPH_ERR_ARG,
+                              "components name world axes; a selection in "
+                              "the frame of placed body '%s' prescribes the "
+                              "whole velocity",
+                              s->bodies[b->select.body].name);
       if (comp) {
         b->mask = 0;
         for (size_t k = 0; k < comp->count; ++k) {
@@ -647,15 +771,23 @@ static sph_status parse_boundaries(sph_scene *s, sph_node *root,
       SPH_TRY(sph_node_get_map(n, conds[which], 1, &c, err));
       static const char *const akeys[] = {"axis", NULL};
       SPH_TRY(sph_node_check_keys(c, akeys, err));
-      SPH_TRY(get_axis(c, "axis", 1, 0, &b->axis, err));
-      if (b->kind != SPH_BC_ROLLER) {
-        if (b->select.kind != SPH_SELECT_PLANE || b->select.axis != b->axis)
-          return sph_node_error(sph_node_child(n, conds[which]), err,
-                                SPH_ERR_ARG,
-                                "a %s plane needs a plane selection normal "
-                                "to the same axis",
-                                conds[which]);
+      SPH_TRY(get_direction(c, "axis", 1, 0, s->dimension, b->normal, err));
+      const sph_transform *T = selection_frame(s, &b->select);
+      if (T) {
+        double w[3];
+        rotate(T, b->normal, w);
+        memcpy(b->normal, w, sizeof w);
       }
+      b->axis = sph_axis_index(b->normal);
+      const double *m = b->select.normal;
+      if (b->kind != SPH_BC_ROLLER &&
+          (b->select.kind != SPH_SELECT_PLANE ||
+           fabs(m[0] * b->normal[0] + m[1] * b->normal[1] +
+                m[2] * b->normal[2]) < 1.0 - 1e-12))
+        return sph_node_error(sph_node_child(n, conds[which]), err, SPH_ERR_ARG,
+                              "a %s plane needs a plane selection with the "
+                              "same normal",
+                              conds[which]);
     }
   }
   return SPH_OK;
@@ -1049,13 +1181,51 @@ int sph_scene_find_body(const sph_scene *s, const char *name) {
   return -1;
 }
 
+void sph_body_local(const sph_body *b, const double X[3], double Xb[3]) {
+  const sph_transform *T = &b->transform;
+  if (!T->given) {
+    memmove(Xb, X, 3 * sizeof *X);
+    return;
+  }
+  double d[3] = {X[0] - T->t[0], X[1] - T->t[1], X[2] - T->t[2]};
+  for (int i = 0; i < 3; ++i)
+    Xb[i] = T->R[i] * d[0] + T->R[3 + i] * d[1] + T->R[6 + i] * d[2];
+}
+
+void sph_body_world(const sph_body *b, const double Xb[3], double X[3]) {
+  const sph_transform *T = &b->transform;
+  if (!T->given) {
+    memmove(X, Xb, 3 * sizeof *X);
+    return;
+  }
+  double r[3];
+  rotate(T, Xb, r);
+  for (int i = 0; i < 3; ++i)
+    X[i] = r[i] + T->t[i];
+}
+
+int sph_axis_index(const double n[3]) {
+  for (int a = 0; a < 3; ++a)
+    if (n[a] == 1.0 && n[(a + 1) % 3] == 0.0 && n[(a + 2) % 3] == 0.0)
+      return a;
+  return -1;
+}
+
 int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
                            int body, const double X[3]) {
   if (sel->body >= 0 && body != sel->body)
     return 0;
+  double Xb[3];
+  if (sel->kind != SPH_SELECT_PLANE && sel->body >= 0) {
+    sph_body_local(&s->bodies[sel->body], X, Xb);
+    X = Xb;
+  }
   switch (sel->kind) {
   case SPH_SELECT_PLANE:
-    return fabs(X[sel->axis] - sel->at) <= sel->tolerance;
+    if (sel->axis >= 0)
+      return fabs(X[sel->axis] - sel->at) <= sel->tolerance;
+    return fabs(X[0] * sel->normal[0] + X[1] * sel->normal[1] +
+                X[2] * sel->normal[2] - sel->at) <= sel->tolerance;
   case SPH_SELECT_BOX:
     for (int c = 0; c < s->dimension; ++c)
       if (X[c] < sel->min[c] - sel->tolerance ||
@@ -1091,8 +1261,7 @@ static void initial_velocity(const sph_velocity *v, const double X[3],
     double w =
         v->omega *
         (v->profile ? sph_expr_eval(v->profile, X[0], X[1], X[2], 0.0) : 1.0);
-    double omega[3] = {0, 0, 0}, r[3];
-    omega[v->axis] = w;
+    double omega[3] = {w * v->axis[0], w * v->axis[1], w * v->axis[2]}, r[3];
     for (int c = 0; c < 3; ++c)
       r[c] = X[c] - v->center[c];
     out[0] = omega[1] * r[2] - omega[2] * r[1];
@@ -1171,11 +1340,21 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
     st = sph_particles_create(&ps, total, s->dimension, err);
   if (st == SPH_OK)
     st = sph_particles_require(ps, SPH_FIELD_VELOCITY, err);
+  /* positions and initial velocities from the body frame to the world */
   for (size_t b = 0; st == SPH_OK && b < s->nbodies; ++b)
     for (size_t i = 0; st == SPH_OK && i < ns[b]; ++i) {
-      st = sph_particles_append(ps, xs[b] + 3 * i, vs[b][i], (int32_t)b, err);
-      initial_velocity(&s->bodies[b].velocity, xs[b] + 3 * i,
-                       ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1));
+      const sph_body *bd = &s->bodies[b];
+      double X[3], vb[3];
+      sph_body_world(bd, xs[b] + 3 * i, X);
+      st = sph_particles_append(ps, X, vs[b][i], (int32_t)b, err);
+      if (st != SPH_OK)
+        break;
+      double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1);
+      initial_velocity(&bd->velocity, xs[b] + 3 * i, vb);
+      if (bd->transform.given)
+        rotate(&bd->transform, vb, v);
+      else
+        memcpy(v, vb, sizeof vb);
     }
   for (size_t b = 0; xs && vs && b < s->nbodies; ++b) {
     free(xs[b]);

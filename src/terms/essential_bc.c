@@ -1,6 +1,7 @@
 /* Essential boundary conditions imposed directly on the particles (seed 000
  * Algorithm 1 step 8): clamped particles keep zero momentum, rollers zero
- * normal momentum, prescribed velocities p = rho0 v inside their time window
+ * normal momentum (p - (p . n) n for an oblique normal n), prescribed
+ * velocities p = rho0 v inside their time window
  * (after it the particles are free). The rates of constrained components are
  * zeroed and the state is reset after every update. */
 #include <math.h>
@@ -20,13 +21,14 @@ typedef struct essential_bc {
   size_t nsets;
 } essential_bc;
 
-/* Components the boundary fixes at time t (bit mask), 0 when inactive. */
+/* Components the boundary fixes at time t (bit mask), 0 when inactive; an
+ * oblique roller fixes none of them (projected in `apply`). */
 static unsigned fixed_mask(const sph_boundary *bc, double t) {
   switch (bc->kind) {
   case SPH_BC_CLAMP:
     return 7u;
   case SPH_BC_ROLLER:
-    return 1u << bc->axis;
+    return bc->axis >= 0 ? 1u << bc->axis : 0u;
   case SPH_BC_VELOCITY:
     return (t >= bc->from && t < bc->until) ? bc->mask : 0u;
   default:
@@ -34,9 +36,24 @@ static unsigned fixed_mask(const sph_boundary *bc, double t) {
   }
 }
 
+/* v - (v . n) n */
+static void drop_normal(double *v, const double n[3]) {
+  double vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+  for (int c = 0; c < 3; ++c)
+    v[c] -= vn * n[c];
+}
+
 static void apply(essential_bc *e, double t, double *p, double *dp) {
   for (size_t s = 0; s < e->nsets; ++s) {
     const sph_boundary *bc = e->sets[s].bc;
+    if (bc->kind == SPH_BC_ROLLER && bc->axis < 0)
+      for (size_t k = 0; k < e->sets[s].count; ++k) {
+        size_t a = e->sets[s].index[k];
+        if (dp)
+          drop_normal(dp + 3 * a, bc->normal);
+        if (p)
+          drop_normal(p + 3 * a, bc->normal);
+      }
     unsigned mask = fixed_mask(bc, t);
     if (!mask)
       continue;

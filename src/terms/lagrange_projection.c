@@ -25,6 +25,7 @@
  * default. */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -379,6 +380,20 @@ sph_status lagrange_projection_create(sph_sim *sim, const sph_cloud *cloud,
                          "essential_bc: lagrange handles at most 32 "
                          "boundaries, the scene has %zu",
                          s->nboundaries);
+  /* the blocks are per coordinate component: normals along an axis only */
+  for (size_t k = 0; k < s->nboundaries; ++k) {
+    const sph_boundary *bc = &s->boundaries[k];
+    char key[48];
+    snprintf(key, sizeof key, "boundaries[%zu]", k);
+    if (is_constraint(bc) && bc->kind != SPH_BC_CLAMP &&
+        bc->kind != SPH_BC_VELOCITY && bc->axis < 0)
+      return sph_error_at(err, SPH_ERR_UNSUPPORTED, s->path, bc->line, bc->col,
+                          key,
+                          "boundary '%s': essential_bc: lagrange needs a "
+                          "normal along x, y or z (use essential_bc: direct "
+                          "for an oblique plane)",
+                          bc->name);
+  }
   lagrange_projection *lp = calloc(1, sizeof *lp);
   if (!lp)
     return sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");

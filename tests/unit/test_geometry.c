@@ -48,7 +48,7 @@ static sph_body round_body(sph_shape_kind kind, double dp) {
   b.shape.radius = 0.04;
   b.shape.inner_radius = 0.02;
   b.shape.outer_radius = 0.04;
-  b.shape.axis = 2;
+  b.shape.axis[2] = 1.0;
   b.shape.length = 0.05;
   b.spacing = dp;
   b.seed = 1;
@@ -286,7 +286,7 @@ START_TEST(distances_bounds_and_measures) {
   s.kind = SPH_SHAPE_CYLINDER;
   s.radius = 1.0;
   s.length = 2.0;
-  s.axis = 1;
+  s.axis[1] = 1.0;
   check_distance(&s, 3, 0.0, 1.0, 0.0, -1.0);
   check_distance(&s, 3, 0.0, 0.25, 0.0, -0.25);
   check_distance(&s, 3, 0.6, 1.0, 0.8, 0.0);
@@ -298,10 +298,25 @@ START_TEST(distances_bounds_and_measures) {
   sph_shape_bounds(&s, 3, lo, hi);
   ck_assert(lo[1] == 0.0 && hi[1] == 2.0 && lo[0] == -1.0 && hi[0] == 1.0);
   ck_assert(lo[2] == -1.0 && hi[2] == 1.0);
+  /* the same cylinder turned about x, axis (0, 0.6, 0.8) = R e_y: the
+   * distance at R X is the distance at X; bounds from the end discs */
+  sph_shape t = s;
+  memcpy(t.axis, (double[3]){0.0, 0.6, 0.8}, sizeof t.axis);
+  const double P[7][3] = {{0, 1, 0},    {0, 0.25, 0}, {0.6, 1, 0.8}, {0, 3, 0},
+                          {0, -1, 0.5}, {2, -1, 0},   {0, 1, -3}};
+  for (int k = 0; k < 7; ++k)
+    check_distance(&t, 3, P[k][0], 0.6 * P[k][1] - 0.8 * P[k][2],
+                   0.8 * P[k][1] + 0.6 * P[k][2],
+                   sph_shape_distance(&s, 3, P[k]));
+  sph_shape_bounds(&t, 3, lo, hi);
+  ck_assert(lo[0] == -1.0 && hi[0] == 1.0);
+  ck_assert(fabs(lo[1] + 0.8) < 4 * EPS && fabs(hi[1] - 2.0) < 4 * EPS);
+  ck_assert(fabs(lo[2] + 0.6) < 4 * EPS && fabs(hi[2] - 2.2) < 4 * EPS);
   /* 3D ring: a tube of radii 0.5, 1 along x from x = 1, length 3 */
   s.kind = SPH_SHAPE_RING;
   s.center[0] = 1.0;
-  s.axis = 0;
+  s.axis[0] = 1.0;
+  s.axis[1] = 0.0;
   s.length = 3.0;
   s.inner_radius = 0.5;
   s.outer_radius = 1.0;

@@ -165,6 +165,7 @@ START_TEST(cube_initial_state) {
 }
 END_TEST
 
+/* refusals: ul-sph (stress starts at zero), a placed body */
 START_TEST(cube_refused_by_ul_sph) {
   char path[512];
   snprintf(path, sizeof path, "%s/scenes/swinging_cube.yaml", SPH_SOURCE_DIR);
@@ -175,6 +176,13 @@ START_TEST(cube_refused_by_ul_sph) {
   ck_assert(sph_scene_load(&s, path, sets, 2, &err) == SPH_OK);
   ck_assert(sph_sim_create(&sim, s, &err) != SPH_OK);
   ck_assert_msg(strstr(err.message, "deformed state"), "%s", err.message);
+  sph_scene_destroy(s);
+  /* eq. 52 is written in the world frame: a placed body is refused */
+  const char *placed[] = {"bodies.0.transform={rotate: {axis: x, angle: 360}}"};
+  ck_assert(sph_scene_load(&s, path, placed, 1, &err) == SPH_OK);
+  ck_assert(sph_sim_create(&sim, s, &err) == SPH_ERR_ARG);
+  ck_assert_msg(strstr(err.message, "world frame"), "%s", err.message);
+  ck_assert_str_eq(err.key, "reference");
   sph_scene_destroy(s);
 }
 END_TEST

@@ -47,11 +47,11 @@ static sph_status load_text(const char *text, sph_scene **s,
   return st;
 }
 
-/* good scene with one line replaced by `line` (1-based) */
-static char *with_line(int lineno, const char *line) {
-  static char buf[4096];
+/* `base` with one line replaced by `line` (1-based), into buf[4096] */
+static char *replace_line(char *buf, const char *base, int lineno,
+                          const char *line) {
   buf[0] = '\0';
-  const char *p = good;
+  const char *p = base;
   for (int i = 1; *p; ++i) {
     const char *e = strchr(p, '\n');
     size_t len = e ? (size_t)(e - p) + 1 : strlen(p);
@@ -64,6 +64,12 @@ static char *with_line(int lineno, const char *line) {
     p += len;
   }
   return buf;
+}
+
+/* good scene with one line replaced by `line` (1-based) */
+static char *with_line(int lineno, const char *line) {
+  static char buf[4096];
+  return replace_line(buf, good, lineno, line);
 }
 
 /* the error must point at `needle` on line `line` of the text */
@@ -233,6 +239,107 @@ START_TEST(dimension_and_shape_errors) {
 }
 END_TEST
 
+/* a body transform places the particles, turns the initial velocity and
+ * the selections that name the body; vectors are normalised */
+START_TEST(placed_body) {
+  char text[4096];
+  snprintf(text, sizeof text, "%s",
+           with_line(11, "    initial_velocity: {rotation: {axis: [0, 2, 0], "
+                         "omega: 105, profile: \"sin(pi*y/(2*6))\"}}\n"
+                         "    transform: {rotate: {axis: [3, 0, 0], angle: "
+                         "-270}, translate: [1, 2, 3]}"));
+  const char *sets[] = {"boundaries.0.select.plane.body=column",
+                        "output.probes=[]"};
+  sph_scene *s;
+  sph_error err;
+  ck_assert_int_eq(load_text(text, &s, sets, 2, &err), SPH_OK);
+  /* -270 degrees about x is +90: (x, y, z) -> (x, -z, y), exactly */
+  const sph_transform *T = &s->bodies[0].transform;
+  const double R[9] = {1, 0, 0, 0, 0, -1, 0, 1, 0};
+  for (int k = 0; k < 9; ++k)
+    ck_assert(T->R[k] == R[k]);
+  /* the base plane y = 0 of the column is the world plane z = 3 */
+  const sph_selection *sel = &s->boundaries[0].select;
+  ck_assert_int_eq(sel->axis, 2);
+  ck_assert(sel->at == 3.0);
+  sph_particles *ps;
+  ck_assert_int_eq(sph_scene_build_particles(s, &ps, &err), SPH_OK);
+  int base = 0, tips = 0;
+  for (size_t a = 0; a < ps->n; ++a) {
+    base += (ps->flags[a] & SPH_FLAG_BOUNDARY) != 0;
+    const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+    const double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * a;
+    /* the tip (0.5, 6, 0.5) of the body frame; there v = (52.5, 0, -52.5) */
+    if (X[0] == 1.5 && X[1] == 1.5 && X[2] == 9.0) {
+      ++tips;
+      ck_assert(fabs(v[0] - 52.5) < 1e-12 && fabs(v[1] - 52.5) < 1e-12 &&
+                fabs(v[2]) < 1e-12);
+    }
+  }
+  ck_assert_int_eq(base, 25);
+  ck_assert_int_eq(tips, 1);
+  sph_particles_destroy(ps);
+  sph_scene_destroy(s);
+  /* an oblique roller: [0, 3, 4] is (0, 0.6, 0.8) */
+  const char *roller[] = {
+      "boundaries.0={name: r, select: {plane: {axis: [0, 1, 0], at: 0}}, "
+      "roller: {axis: [0, 3, 4]}}"};
+  ck_assert_int_eq(load_text(good, &s, roller, 1, &err), SPH_OK);
+  const sph_boundary *b = &s->boundaries[0];
+  ck_assert_int_eq(b->axis, -1);
+  ck_assert(b->normal[0] == 0.0 && fabs(b->normal[1] - 0.6) < 1e-16 &&
+            fabs(b->normal[2] - 0.8) < 1e-16);
+  ck_assert_int_eq(b->select.axis, 1); /* [0, 1, 0] is y */
+  sph_scene_destroy(s);
+}
+END_TEST
+
+START_TEST(direction_errors) {
+  expect_error(with_line(13, "  - {name: base, select: {plane: {axis: [0, 0, "
+                             "0], at: 0}}, clamp: true}"),
+               SPH_ERR_RANGE, 13, "axis", "boundaries[0].select.plane.axis",
+               "non-zero");
+  expect_error(with_line(13, "  - {name: base, select: {plane: {axis: [1, 0], "
+                             "at: 0}}, clamp: true}"),
+               SPH_ERR_TYPE, 13, "axis", "boundaries[0].select.plane.axis",
+               "3 numbers");
+  expect_error(with_line(13, "  - {name: base, select: {plane: {axis: w, at: "
+                             "0}}, clamp: true}"),
+               SPH_ERR_RANGE, 13, "axis", "boundaries[0].select.plane.axis",
+               "x, y, z or a vector");
+  expect_error(with_line(13, "  - {name: base, select: {plane: {axis: y, at: "
+                             "0}}, roller: {axis: [0, 0, 0]}}"),
+               SPH_ERR_RANGE, 13, "axis: [0, 0, 0]",
+               "boundaries[0].roller.axis", "non-zero");
+  expect_error(with_line(13, "  - {name: base, select: {plane: {axis: [1, 1, "
+                             "0], at: 0}}, symmetry: {axis: [1, 1, 0.1]}}"),
+               SPH_ERR_ARG, 13, "symmetry", "boundaries[0].symmetry",
+               "same normal");
+  expect_error(with_line(11, "    initial_velocity: {rotation: {axis: [0, "
+                             "0, 0], omega: 1}}"),
+               SPH_ERR_RANGE, 11, "axis",
+               "bodies[0].initial_velocity.rotation.axis", "non-zero");
+  expect_error(with_line(11, "    transform: {rotate: {axis: [0, 0, 0], "
+                             "angle: 10}}"),
+               SPH_ERR_RANGE, 11, "axis", "bodies[0].transform.rotate.axis",
+               "non-zero");
+  expect_error(with_line(11, "    transform: {rotate: {axis: x}}"),
+               SPH_ERR_MISSING_KEY, 11, "rotate",
+               "bodies[0].transform.rotate.angle", "angle");
+  expect_error(with_line(11, "    transform: {rotat: {angle: 10}}"),
+               SPH_ERR_UNKNOWN_KEY, 11, "rotat", "bodies[0].transform.rotat",
+               "did you mean 'rotate'");
+  /* a velocity by components in a turned frame */
+  char text[4096];
+  replace_line(
+      text, with_line(11, "    transform: {rotate: {axis: x, angle: 10}}"), 13,
+      "  - {name: v, select: {plane: {axis: y, at: 0, body: column}}, "
+      "velocity: {value: [1, 0, 0], components: [x]}}");
+  expect_error(text, SPH_ERR_ARG, 13, "components",
+               "boundaries[0].velocity.components", "whole velocity");
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("scene");
   TCase *tc = tcase_create("scene");
@@ -241,6 +348,8 @@ int main(void) {
   tcase_add_test(tc, png_off);
   tcase_add_test(tc, error_classes);
   tcase_add_test(tc, dimension_and_shape_errors);
+  tcase_add_test(tc, placed_body);
+  tcase_add_test(tc, direction_errors);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }

@@ -3,6 +3,7 @@
  * scenes loaded from YAML, their particles generated, positions and von
  * Mises stress filled in directly (no method runs), observed through the
  * same sph_verdict_observe the sph command uses. */
+#include "test_scene_util.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -19,7 +20,7 @@
  * YAML lines (more bodies, a stability block) */
 static sph_scene *load_box(int dim, double lx, double ly, double lz, double dp,
                            const char *particles, const char *extra) {
-  char text[4096], path[64] = "/tmp/sph_verdict_XXXXXX";
+  char text[4096];
   char lo[64], hi[64];
   if (dim == 3) {
     snprintf(lo, sizeof lo, "[0, 0, 0]");
@@ -37,16 +38,7 @@ static sph_scene *load_box(int dim, double lx, double ly, double lz, double dp,
            "    particles: {spacing: %g%s}\n%s"
            "time: {end: 1}\n",
            dim, lo, hi, dp, particles, extra);
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  sph_scene *s;
-  sph_error err;
-  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
-  unlink(path);
-  ck_assert_msg(st == SPH_OK, "%s", err.message);
-  return s;
+  return sph_test_scene_text(text);
 }
 
 /* particles of the scene with POSITION = POSITION0 and a zero von Mises */

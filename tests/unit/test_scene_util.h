@@ -1,0 +1,28 @@
+/* A scene from YAML text for the Check suites: written to a temporary file
+ * (errors then name a real path) and loaded. */
+#ifndef SPH_TEST_SCENE_UTIL_H
+#define SPH_TEST_SCENE_UTIL_H
+
+#include <check.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sph/scene.h"
+
+/* Loads `text` (the file is removed again) and asserts that it loads. */
+static inline sph_scene *sph_test_scene_text(const char *text) {
+  char path[64] = "/tmp/sph_test_XXXXXX";
+  int fd = mkstemp(path);
+  ck_assert_int_ge(fd, 0);
+  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+  close(fd);
+  sph_scene *s;
+  sph_error err;
+  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
+  unlink(path);
+  ck_assert_msg(st == SPH_OK, "%s", err.message);
+  return s;
+}
+
+#endif
