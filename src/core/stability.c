@@ -74,6 +74,66 @@ static double pair_distance(const double *x, size_t a, size_t b, int dim) {
   return sqrt(d2);
 }
 
+/* Particles a support of body b holds on a full lattice: the support's
+ * volume in units of dp^dim */
+static double support_count(const sph_verdict *v, int32_t b, int dim) {
+  double r = v->body_kernel[b].support / v->body_dp[b];
+  return dim == 3   ? 4.0 / 3.0 * M_PI * r * r * r
+         : dim == 2 ? M_PI * r * r
+                    : 2.0 * r;
+}
+
+/* The particles the zig-zag roughness is judged on (1), from the reference
+ * lists in v->nl: those of bodies with an interior at least one support
+ * across. A particle whose support holds fewer than SPH_ZIGZAG_SURFACE of
+ * a full support's particles is at a surface; an interior particle has no
+ * surface particle in its support, so the fit around it interpolates a
+ * field resolved on every side. A body with fewer interior particles than
+ * one support holds is too coarse to judge (0): no interior at 5 or 6
+ * particles across, 8 at 8 across (a 3D support reaches 2.6 dp). */
+static sph_status zigzag_interior(sph_verdict *v, const sph_scene *s,
+                                  const sph_particles *ps, sph_error *err) {
+  size_t n = ps->n, nb = s->nbodies ? s->nbodies : 1;
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  const sph_neighbors *nl = v->nl;
+  int dim = s->dimension;
+  char *flag = v->zigzag_judged = calloc(n ? n : 1, 1);
+  size_t *count = calloc(nb, sizeof *count);
+  if (!flag || !count) {
+    free(count);
+    return sph_error_set(err, SPH_ERR_NOMEM, "verdict");
+  }
+  /* surface particles (1) */
+  for (size_t a = 0; a < n; ++a) {
+    double r = v->body_kernel[ps->body[a]].support;
+    size_t k = 0;
+    for (size_t j = nl->offset[a]; j < nl->offset[a + 1]; ++j)
+      k += pair_distance(X, a, (size_t)nl->index[j], dim) < r;
+    flag[a] =
+        (double)k < SPH_ZIGZAG_SURFACE * support_count(v, ps->body[a], dim);
+  }
+  /* interior: no surface particle within the support */
+  for (size_t a = 0; a < n; ++a) {
+    if (flag[a] == 1)
+      continue;
+    double r = v->body_kernel[ps->body[a]].support;
+    int inside = 1;
+    for (size_t j = nl->offset[a]; inside && j < nl->offset[a + 1]; ++j) {
+      size_t b = (size_t)nl->index[j];
+      inside = !(flag[b] == 1 && pair_distance(X, a, b, dim) < r);
+    }
+    flag[a] = inside ? 2 : 3; /* 3: near a surface */
+  }
+  for (size_t a = 0; a < n; ++a)
+    count[ps->body[a]] += flag[a] == 2;
+  for (size_t a = 0; a < n; ++a) {
+    flag[a] = (double)count[ps->body[a]] >= support_count(v, ps->body[a], dim);
+    v->zigzag_count += (size_t)flag[a];
+  }
+  free(count);
+  return SPH_OK;
+}
+
 /* Per-body spacings and kernels, the current-configuration neighbour lists
  * (sized by a build in the reference configuration) and the initially
  * adjacent pairs, taken from that same build. */
@@ -108,6 +168,7 @@ static sph_status lists_create(sph_verdict *v, const sph_scene *s,
   SPH_TRY(sph_neighbors_build(v->nl, X, n, dim, v->zigzag_radius, ps->body,
                               SPH_PAIRS_SAME_BODY, err));
   const sph_neighbors *nl = v->nl;
+  SPH_TRY(zigzag_interior(v, s, ps, err));
   for (int pass = 0; pass < 2; ++pass) {
     size_t k = 0;
     for (size_t a = 0; a < n; ++a) {
@@ -183,6 +244,7 @@ void sph_verdict_destroy(sph_verdict *v) {
   free(v->body_dp);
   free(v->body_kernel);
   free(v->work);
+  free(v->zigzag_judged);
   sph_neighbors_destroy(v->nl);
   free(v);
 }
@@ -246,7 +308,8 @@ static sph_status zigzag_update(sph_verdict *v, const sph_particles *ps,
   const double *s = ps->field[SPH_FIELD_VON_MISES];
   const double *V = ps->field[SPH_FIELD_VOLUME0];
   v->zigzag = NAN;
-  if (!x || !s || !ps->n || ps->n != v->n || !(v->zigzag_radius > 0.0))
+  if (!x || !s || !ps->n || ps->n != v->n || !(v->zigzag_radius > 0.0) ||
+      !v->zigzag_count)
     return SPH_OK;
   SPH_TRY(sph_neighbors_build(v->nl, x, ps->n, ps->dim, v->zigzag_radius,
                               ps->body, SPH_PAIRS_SAME_BODY, err));
@@ -256,6 +319,10 @@ static sph_status zigzag_update(sph_verdict *v, const sph_particles *ps,
   int dim = ps->dim;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
+    if (!v->zigzag_judged[a]) { /* a body too coarse to judge */
+      smooth[a] = NAN;
+      continue;
+    }
     const sph_kernel *k = &v->body_kernel[ps->body[a]];
     const double *xa = x + 3 * a;
     /* kernel-weighted moments of the offsets d and of s, in one pass */

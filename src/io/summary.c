@@ -118,6 +118,8 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   fprintf(f,
           ", \"pairs_over\": %ld},\n  \"zigzag_max\": ", v->fracture_peak_over);
   json_number(f, v->zigzag_max);
+  /* particles R is judged on (0: every body too coarse to judge) */
+  fprintf(f, ",\n  \"zigzag_judged_particles\": %zu", v->zigzag_count);
   fprintf(f, ",\n  \"nan\": %s,\n  \"stable\": %s,\n  \"reason\": ",
           v->nan ? "true" : "false", v->stable ? "true" : "false");
   json_string(f, v->reason);

@@ -83,10 +83,11 @@ check "resume after kill exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'
 check "resume ran $((3 - rows)) case(s)" 'grep -q "3 cases ($((3 - rows)) to run" "$work/stdout" && [ "$(grep -c "^\[" "$work/stdout")" -eq $((3 - rows)) ]'
 check "3 rows after resume" '[ "$(wc -l <"$out3/results.csv")" -eq 4 ] && [ "$(cut -d, -f1 "$out3/results.csv" | tail -3 | sort -g | tr "\n" " ")" = "0.05 0.0625 0.25 " ]'
 
-# --- bracketed values; unstable runs stay rows
+# --- bracketed values; unstable runs stay rows (a fracture threshold of
+# 1.01 dp trips on any stretch)
 out2=$work/brackets
 "$sph" study "$scene" "${short[@]}" --set 'bodies.0.particles={count: [3,3,3]}' \
-  --vary 'bodies.0.particles.count=[3,3,3],[5,5,5]' --out "$out2" \
+  --set stability.fracture_dp=1.01 --vary 'bodies.0.particles.count=[3,3,3],[5,5,5]' --out "$out2" \
   >"$work/stdout" 2>"$work/stderr"
 rc=$?
 check "bracket study exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'

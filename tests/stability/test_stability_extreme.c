@@ -304,7 +304,9 @@ START_TEST(rings_enog_past_the_rebound) {
                   frac[i], rt.ke_max, rt.ke0);
     ck_assert_msg(o.stretch_max < SPH_FRACTURE_DP && o.pairs_over == 0,
                   "stretch %g dp", o.stretch_max);
-    ck_assert_msg(o.zigzag_max < SPH_ZIGZAG_MAX, "zig-zag %g", o.zigzag_max);
+    /* (NaN: rings 5 particles thick are too coarse to be judged) */
+    ck_assert_msg(!isgreaterequal(o.zigzag_max, SPH_ZIGZAG_MAX), "zig-zag %g",
+                  o.zigzag_max);
     ck_assert_msg(rt.vx_end < 0.0 && rt.gap > 0.0,
                   "%g c0: the rings did not part (v_x %g, gap %g)", frac[i],
                   rt.vx_end, rt.gap);

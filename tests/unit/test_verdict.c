@@ -302,7 +302,8 @@ static double roughness(fixture *f, int quadratic, double amp) {
 
 static sph_scene *jittered(int dim) {
   const char *p = ", distribution: jitter, jitter: 0.25, seed: 7";
-  return dim == 3 ? load_box(3, 1.0, 1.0, 1.0, 0.1, p, "")
+  /* 12 and 20 particles across: interiors of 6^3 and 14^2 particles */
+  return dim == 3 ? load_box(3, 1.0, 1.0, 1.0, 1.0 / 12.0, p, "")
                   : load_box(2, 1.0, 1.0, 0.0, 0.05, p, "");
 }
 
@@ -374,6 +375,42 @@ START_TEST(zigzag_is_scale_free_and_can_be_off) {
 }
 END_TEST
 
+/* Bodies whose interior is smaller than one support (a 3D support holds
+ * 74 lattice particles, a 2D one 21) are not judged, whatever their field:
+ * 6 and 8 particles across in 3D (no interior, 2^3), 5 across a long 2D
+ * strip (no interior); 9 across in 3D (3^3 = 27 interior) neither, 12
+ * across (6^3 = 216) is. The limit: a genuine zig-zag in so coarse a body
+ * goes unseen by this indicator (the pressure checkerboard still sees a
+ * red-black mode). */
+START_TEST(coarse_bodies_are_not_judged) {
+  const char *p = ", distribution: jitter, jitter: 0.25, seed: 7";
+  const struct {
+    int dim, across;
+    double lx, ly;
+    int judged;
+  } cases[] = {{3, 6, 1, 1, 0},  {3, 8, 1, 1, 0},   {3, 9, 1, 1, 0},
+               {3, 12, 1, 1, 1}, {2, 5, 0.5, 4, 0}, {2, 10, 1, 4, 1}};
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; ++i) {
+    double dp = cases[i].lx / cases[i].across;
+    fixture f;
+    fixture_make(&f, load_box(cases[i].dim, cases[i].lx, cases[i].ly,
+                              cases[i].dim == 3 ? 1.0 : 0.0, dp, p, ""));
+    double R = roughness(&f, 1, 0.5); /* a strong alternation */
+    printf("zig-zag, %dD, %d across: %zu of %zu particles judged, R %.3f\n",
+           cases[i].dim, cases[i].across, f.v->zigzag_count, f.ps->n, R);
+    if (cases[i].judged) {
+      ck_assert_uint_eq(f.v->zigzag_count, f.ps->n);
+      ck_assert(R > SPH_ZIGZAG_MAX && !f.v->stable);
+    } else {
+      ck_assert_uint_eq(f.v->zigzag_count, 0);
+      ck_assert(isnan(R) && isnan(f.v->zigzag_max));
+      ck_assert_msg(f.v->stable, "%s", f.v->reason);
+    }
+    fixture_free(&f);
+  }
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("verdict");
   TCase *tc = tcase_create("fracture and zig-zag");
@@ -387,6 +424,7 @@ int main(void) {
   tcase_add_test(tc, smooth_fields_are_not_zigzag);
   tcase_add_test(tc, alternation_is_zigzag);
   tcase_add_test(tc, zigzag_is_scale_free_and_can_be_off);
+  tcase_add_test(tc, coarse_bodies_are_not_judged);
   tcase_add_test(tc, energy_growth_above_round_off);
   tcase_add_test(tc, indicator_keys);
   suite_add_tcase(s, tc);
