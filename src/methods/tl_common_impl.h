@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "methods/tl_iact.h"
 #include "sph/material.h"
 #include "sph/neighbors.h"
 #include "sph/sim.h"
@@ -66,6 +67,27 @@ static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
   double Q[9];
   sph_mat3_mul(ref->P + 9 * a, ref->L + 9 * a, Q);
   sph_mat3_transpose(Q, ref->Qt + 9 * a);
+}
+
+/* The pair sums of particle a over its neighbours (methods/tl_iact.h): the
+ * uncorrected gradient of the vector field f (when f is not NULL) and the
+ * pair part of the conservative force (when `force`); the constant
+ * arguments of each caller specialise the loop. */
+static inline void tl_pair_sums(const tl_reference *ref, size_t a,
+                                const double *f, int force, tl_sums *s) {
+  const sph_neighbors *nl = ref->nl;
+  const double *Xa = ref->X + 3 * a;
+  *s = (tl_sums){0};
+  for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+    size_t b = (size_t)nl->index[k];
+    tl_v2 r01;
+    double r2;
+    tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
+    if (f)
+      tl_iact_gradient2(s, ref->w[k], f + 3 * a, f + 3 * b, r01, r2);
+    if (force)
+      tl_iact_force2(s, ref->w[k], ref->Qt + 9 * b, r01, r2);
+  }
 }
 
 /* Internal force of seed 000 eq. 29c / 42 into dp (overwritten) for the

@@ -17,22 +17,13 @@
 /* F from positions for the particles, images mirrored, P for every point */
 static void deformation_and_stress(tl_csph *m, long n) {
   tl_reference *ref = &m->ref;
-  const sph_neighbors *nl = ref->nl;
   long ne = (long)ref->n_ext;
   if (ne > n) /* image positions and momenta from their sources */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    const double *Xa = ref->X + 3 * a;
-    tl_sums s = {0};
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
-      size_t b = (size_t)nl->index[k];
-      tl_v2 r01;
-      double r2;
-      tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
-      tl_csph_iact_deformation(&s, ref->w[k], m->x + 3 * a, m->x + 3 * b, r01,
-                               r2);
-    }
+    tl_sums s; /* F = grad_0 x (seed 001 eq. 9) */
+    tl_pair_sums(ref, (size_t)a, m->x, 0, &s);
     double F[9], unused[3];
     tl_sums_store(&s, F, unused);
     tl_iact_gradient_correct(F, ref->L + 9 * a);

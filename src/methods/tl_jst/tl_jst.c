@@ -81,19 +81,10 @@ static inline void particle_rates(tl_jst *m, size_t a, double G[9],
 /* one sweep for the momentum gradient and the force of eq. 42 */
 static void sweep_conservative(tl_jst *m, long n) {
   const tl_reference *ref = &m->ref;
-  const sph_neighbors *nl = ref->nl;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    const double *pa = m->p + 3 * a, *Xa = ref->X + 3 * a;
-    tl_sums s = {0};
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
-      size_t b = (size_t)nl->index[k];
-      tl_v2 r01;
-      double r2;
-      tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
-      tl_iact_gradient2(&s, ref->w[k], pa, m->p + 3 * b, r01, r2);
-      tl_iact_force2(&s, ref->w[k], ref->Qt + 9 * b, r01, r2);
-    }
+    tl_sums s;
+    tl_pair_sums(ref, (size_t)a, m->p, 1, &s);
     double G[9], f[3], self[3];
     tl_sums_store(&s, G, f);
     tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
