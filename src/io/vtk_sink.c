@@ -174,18 +174,20 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
   sph_atomic_file af;
   SPH_TRY(sph_atomic_open(&af, path, err));
   FILE *f = af.f;
+  /* the time as the data set's field data, where VTK's reader finds it */
   fprintf(f,
           "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" "
           "version=\"1.0\" byte_order=\"LittleEndian\" "
-          "header_type=\"UInt64\">\n  <PolyData>\n    <Piece "
+          "header_type=\"UInt64\">\n  <PolyData>\n    <FieldData>\n"
+          "      <DataArray type=\"Float64\" Name=\"TimeValue\" "
+          "NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n"
+          "    </FieldData>\n",
+          fr->time);
+  fprintf(f,
+          "    <Piece "
           "NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
           "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n",
           n, n);
-  fprintf(f,
-          "      <FieldData>\n        <DataArray type=\"Float64\" "
-          "Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
-          "%.17g</DataArray>\n      </FieldData>\n",
-          fr->time);
   uint64_t offset = 0;
   fputs("      <PointData>\n", f);
   for (int i = 0; i < na; ++i)

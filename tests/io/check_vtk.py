@@ -4,7 +4,8 @@ checks it: the .pvd is a Collection with increasing times and every file
 present; every .vtp reads without a VTK error or warning (each in its own
 process: a malformed header can abort the reader); point counts, array
 names and component counts; binary and ASCII runs hold identical values;
-points equal initial_position + displacement; the probe particle's values
+points equal initial_position + displacement; each file's TimeValue field
+data equals its .pvd time; the probe particle's values
 equal probes.csv. Usage: check_vtk.py BINARY_DIR ASCII_DIR SCENE_NAME
 or check_vtk.py --series DIR SCENE_NAME: the .pvd and every file it lists
 read cleanly with the same point count (e.g. after a killed run)."""
@@ -43,6 +44,8 @@ def read_one(path):
     out = {"npoints": poly.GetNumberOfPoints(),
            "nverts": poly.GetNumberOfVerts(),
            "points": values(poly.GetPoints().GetData())}
+    tv = poly.GetFieldData().GetArray("TimeValue")
+    out["time"] = tv.GetTuple1(0) if tv is not None else None
     pd = poly.GetPointData()
     for i in range(pd.GetNumberOfArrays()):
         a = pd.GetArray(i)
@@ -99,6 +102,11 @@ def main():
         if b is None or a is None:
             continue
         n = b["npoints"]
+        # each file carries its own time, read by VTK (TimeValue)
+        for d in (b, a):
+            if d["time"] is None or not close(d["time"], tb[k], 1e-15):
+                fail("%s: TimeValue %s, the .pvd says %r" %
+                     (path_b, d["time"], tb[k]))
         if n != a["npoints"] or b["nverts"] != n:
             fail("%s: %d points, %d verts" % (path_b, n, b["nverts"]))
         for arr, nc in EXPECTED.items():
