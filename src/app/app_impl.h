@@ -37,6 +37,10 @@ int sph_app_mkdir_p(const char *path);
 const char *sph_app_scenes_dir(void);
 const char *sph_app_default_scene(void);
 
+/* Version, commit and this process's command line (set by main). */
+struct sph_provenance;
+void sph_app_provenance(struct sph_provenance *prov);
+
 /* Prints "sph: file:line:col: key: message" to stderr. */
 void sph_app_print_error(const sph_error *err);
 

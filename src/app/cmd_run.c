@@ -100,7 +100,11 @@ static sph_status write_scene_used(const sph_scene *s, const char *dir,
   sph_status st = sph_atomic_open(&af, path, err);
   if (st != SPH_OK)
     return st;
-  fprintf(af.f, "# %s as run by sph, every default filled in\n", s->path);
+  sph_provenance prov;
+  sph_app_provenance(&prov);
+  fprintf(af.f, "# %s as run by sph %s (commit %s), every default filled in\n",
+          s->path, prov.version, prov.commit);
+  fprintf(af.f, "# command: %s\n", prov.command);
   st = sph_node_write(s->root, af.f, err);
   if (st == SPH_OK)
     st = sph_atomic_commit(&af, err);
@@ -306,7 +310,9 @@ int sph_cmd_run(int argc, char **argv) {
   if (verdict && !io_failed) {
     char spath[1200];
     snprintf(spath, sizeof spath, "%s/summary.json", dir);
-    if (sph_summary_write(spath, sim, verdict, wall, sinks, nsinks,
+    sph_provenance prov;
+    sph_app_provenance(&prov);
+    if (sph_summary_write(spath, sim, &prov, verdict, wall, sinks, nsinks,
                           mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
                           completed, &cerr) != SPH_OK) {
       io_failed = 1;

@@ -12,6 +12,7 @@
 #include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
+#include "sph/stability.h"
 
 static void usage(FILE *out) {
   fprintf(out,
@@ -55,6 +56,26 @@ const char *sph_app_default_scene(void) {
   static char path[1024];
   snprintf(path, sizeof path, "%s/twisting_column.yaml", sph_app_scenes_dir());
   return path;
+}
+
+static char command_line[4096];
+
+/* Joins argv with spaces into command_line (truncated if longer). */
+static void remember_command_line(int argc, char **argv) {
+  size_t len = 0;
+  for (int i = 0; i < argc && len + 1 < sizeof command_line; ++i) {
+    int n = snprintf(command_line + len, sizeof command_line - len, "%s%s",
+                     i ? " " : "", argv[i]);
+    if (n < 0)
+      break;
+    len += (size_t)n;
+  }
+}
+
+void sph_app_provenance(sph_provenance *prov) {
+  prov->version = SPH_VERSION;
+  prov->commit = SPH_GIT_COMMIT;
+  prov->command = command_line;
 }
 
 void sph_app_print_error(const sph_error *err) {
@@ -170,6 +191,7 @@ static void short_spin_wait_policy(char **argv) {
 
 int main(int argc, char **argv) {
   short_spin_wait_policy(argv);
+  remember_command_line(argc, argv);
   if (argc < 2)
     return sph_cmd_run(argc, argv);
   const char *cmd = argv[1];
@@ -185,6 +207,10 @@ int main(int argc, char **argv) {
     return sph_cmd_imgdiff(argc, argv);
   if (!strcmp(cmd, "bench"))
     return sph_cmd_bench(argc, argv);
+  if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+    printf("sph %s (commit %s)\n", SPH_VERSION, SPH_GIT_COMMIT);
+    return SPH_EXIT_OK;
+  }
   if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
     usage(stdout);
     return SPH_EXIT_OK;
