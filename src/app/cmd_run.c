@@ -151,11 +151,27 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
   return st;
 }
 
+static const int run_allowed[] = {SPH_OPT_SET,
+                                  SPH_OPT_OUT,
+                                  SPH_OPT_THREADS,
+                                  SPH_OPT_RESUME_DIR,
+                                  SPH_OPT_OVERWRITE,
+                                  SPH_OPT_QUIET,
+                                  0};
+static const sph_app_command run_command = {
+    "run",
+    "usage: sph run [SCENE] [--set key=value]... [--out DIR] [--threads N]\n"
+    "               [--overwrite] [--quiet] [--resume DIR]\n"
+    "  simulate SCENE (a file, or a shipped scene's name: sph list; default\n"
+    "  twisting_column) to its end time; exit 0 stable, 1 unstable, 2 bad\n"
+    "  input or usage, 3 I/O failure\n",
+    run_allowed, NULL, NULL};
+
 int sph_cmd_run(int argc, char **argv) {
   sph_app_args args;
-  int rc = sph_app_parse_args(argc, argv, 2, &args, "run");
+  int rc = sph_app_parse_args(argc, argv, &args, &run_command);
   if (rc != SPH_EXIT_OK)
-    return rc;
+    return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   const char *path = args.scene ? args.scene : sph_app_default_scene();
   sph_scene *scene;
   sph_sim *sim;

@@ -32,5 +32,42 @@ head -2 "$work/v/scene_used.yaml" | grep -qF "sph $version (commit" &&
   head -2 "$work/v/scene_used.yaml" | grep -qF "# command: $sph run $tiny" && ok ||
   bad "scene_used.yaml provenance: $(head -2 "$work/v/scene_used.yaml")"
 
+# help: bare sph, sph help [CMD], CMD --help and CMD -h print the usage on
+# stdout and exit 0, whatever else is on the line
+"$sph" >"$work/stdout" 2>&1
+[ $? -eq 0 ] && grep -q '^usage: sph <command>' "$work/stdout" && ok || bad "bare sph: $(cat "$work/stdout")"
+for cmd in run check study list imgdiff bench; do
+  for h in --help -h; do
+    "$sph" $cmd $h >"$work/stdout" 2>"$work/stderr"
+    rc=$?
+    [ $rc -eq 0 ] && grep -q "^usage: sph $cmd" "$work/stdout" && [ ! -s "$work/stderr" ] && ok ||
+      bad "sph $cmd $h (exit $rc): $(cat "$work/stdout" "$work/stderr")"
+  done
+  "$sph" help $cmd | grep -q "^usage: sph $cmd" && ok || bad "sph help $cmd"
+done
+"$sph" run "$tiny" --out "$work/h" -h >/dev/null 2>&1 && [ ! -e "$work/h" ] && ok || bad "run SCENE -h ran"
+"$sph" run --set time.end=1 --frobnicate 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "unknown option --frobnicate" "$work/stderr" && ok || bad "unknown option: $(cat "$work/stderr")"
+"$sph" list extra 2>/dev/null
+[ $? -eq 2 ] && ok || bad "list with an operand"
+
+# --opt=VALUE as well as --opt VALUE
+"$sph" run "$tiny" --out="$work/eq" --set=time.end=0.01 "${quick[@]}" >/dev/null 2>&1 &&
+  [ -f "$work/eq/summary.json" ] && grep -q '"end": 0.01\|end: 0.01' "$work/eq/scene_used.yaml" && ok ||
+  bad "--out=DIR --set=k=v: $(ls "$work" 2>&1)"
+"$sph" study "$tiny" --vary=time.end=0.01,0.02 --dry-run >"$work/stdout" 2>&1 &&
+  grep -q "2 cases valid" "$work/stdout" && ok || bad "study --vary=: $(cat "$work/stdout")"
+
+# a shipped scene by name; an existing path wins; an unknown name lists the
+# shipped ones
+"$sph" check punch >"$work/stdout" 2>&1 && grep -qF "($src/scenes/punch.yaml)" "$work/stdout" && ok ||
+  bad "check punch: $(cat "$work/stdout")"
+"$sph" study punch --vary time.end=0.001 --dry-run >/dev/null 2>&1 && ok || bad "study punch"
+(cd "$work" && cp "$tiny" punch.yaml && "$sph" check punch.yaml) >"$work/stdout" 2>&1 &&
+  grep -qF "(punch.yaml)" "$work/stdout" && ok || bad "a local punch.yaml: $(cat "$work/stdout")"
+"$sph" run no_such_scene >/dev/null 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "no_such_scene" "$work/stderr" && grep -qE "shipped scenes:.* punch .*twisting_column" "$work/stderr" &&
+  [ ! -e outputs/no_such_scene ] && ok || bad "unknown scene name: $(cat "$work/stderr")"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
