@@ -1,6 +1,6 @@
 /* The sph command: sub-commands and the helpers they share. Only this layer
- * prints and chooses exit codes (0 success, 1 failed run or comparison,
- * 2 bad input or usage). */
+ * prints and chooses exit codes (0 success, 1 unstable run or failed
+ * comparison, 2 bad input or usage, 3 I/O or system failure). */
 #ifndef SPH_APP_IMPL_H
 #define SPH_APP_IMPL_H
 
@@ -12,6 +12,10 @@
 #define SPH_EXIT_FAIL 1
 #define SPH_EXIT_USAGE 2
 #define SPH_EXIT_IO 3
+
+/* The exit code of a library status: 3 for I/O and memory, 2 otherwise
+ * (bad input); 0 for SPH_OK. */
+int sph_app_exit_code(sph_status st);
 
 #define SPH_MAX_SETS 64
 

@@ -474,7 +474,7 @@ int sph_cmd_bench(int argc, char **argv) {
   if (!mkdtemp(dir)) {
     fprintf(stderr, "sph bench: cannot create a temporary folder: %s\n",
             strerror(errno));
-    return 3;
+    return SPH_EXIT_IO;
   }
   /* the resident set of a process that sets up the smallest scene (the
    * default column, 625 particles) and takes no step: subtracted before
@@ -490,7 +490,7 @@ int sph_cmd_bench(int argc, char **argv) {
   bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
   if (!res) {
     remove_dir_files(dir);
-    return 3;
+    return SPH_EXIT_IO;
   }
   int failed = 0;
   for (int c = 0; c < ncases; ++c)
@@ -508,7 +508,7 @@ int sph_cmd_bench(int argc, char **argv) {
   if (json && write_json(json, cases, ncases, res, nthr, quick, cores,
                          baseline_kb) != 0) {
     fprintf(stderr, "sph bench: cannot write %s\n", json);
-    rc = 3;
+    rc = SPH_EXIT_IO;
   }
   free(res);
   remove_dir_files(dir);

@@ -205,12 +205,14 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  if (sph_app_mkdir_p(dir) != 0) {
+  struct stat dst;
+  int made = sph_app_mkdir_p(dir) == 0 && stat(dir, &dst) == 0;
+  if (!made || !S_ISDIR(dst.st_mode)) {
     fprintf(stderr, "sph: cannot create the output folder %s: %s\n", dir,
-            strerror(errno));
+            made ? "a file of that name exists" : strerror(errno));
     sph_sim_destroy(sim);
     sph_scene_destroy(scene);
-    return SPH_EXIT_USAGE;
+    return SPH_EXIT_IO;
   }
   if (args.overwrite && !args.resume)
     remove_previous(dir, scene->name);
@@ -243,7 +245,7 @@ int sph_cmd_run(int argc, char **argv) {
       sph_verdict_destroy(verdict);
       sph_sim_destroy(sim);
       sph_scene_destroy(scene);
-      return SPH_EXIT_USAGE;
+      return SPH_EXIT_USAGE; /* the checkpoint is the run's input */
     }
     if (!args.quiet)
       printf("  resume     %s: t = %.6g s, step %lu, next output %d\n", used,
@@ -337,7 +339,7 @@ int sph_cmd_run(int argc, char **argv) {
   }
   if (io_failed) {
     sph_app_print_error(&err);
-    rc = SPH_EXIT_FAIL;
+    rc = sph_app_exit_code(err.code);
   } else if (verdict && !verdict->stable) {
     printf("verdict: UNSTABLE - %s tripped at t = %.6g s: %s (%lu steps, "
            "%.2f s wall)\n",

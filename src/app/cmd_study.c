@@ -462,7 +462,7 @@ static int run_study(study *s, study_args *a) {
   if (sph_app_mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {
     fprintf(stderr, "sph study: cannot write %s: %s\n", s->dir,
             strerror(errno));
-    return SPH_EXIT_FAIL;
+    return SPH_EXIT_IO;
   }
   int todo = 0, done = 0;
   for (int i = 0; i < s->ncases; ++i)
@@ -482,7 +482,7 @@ static int run_study(study *s, study_args *a) {
     if (sph_app_mkdir_p(rundir) != 0) {
       fprintf(stderr, "sph study: cannot create %s: %s\n", rundir,
               strerror(errno));
-      return SPH_EXIT_FAIL;
+      return SPH_EXIT_IO;
     }
     double walls[100];
     for (int r = 0; r < s->repeat; ++r) {
@@ -504,16 +504,17 @@ static int run_study(study *s, study_args *a) {
     if (append_row(s, c, csv) != 0) {
       fprintf(stderr, "sph study: cannot append to %s: %s\n", csv,
               strerror(errno));
-      return SPH_EXIT_FAIL;
+      return SPH_EXIT_IO;
     }
     double elapsed = sph_wtime() - t0;
     progress(s, c, finished, s->ncases, elapsed / done * (todo - done));
   }
   sph_error err;
   sph_error_clear(&err);
-  if (study_report_write(s, &err) != SPH_OK) {
+  sph_status rst = study_report_write(s, &err);
+  if (rst != SPH_OK) {
     sph_app_print_error(&err);
-    return SPH_EXIT_FAIL;
+    return sph_app_exit_code(rst);
   }
   printf("report: %s/report.md, results: %s\n", s->dir, csv);
   sph_status st = study_plots_write(s, &err);
@@ -555,7 +556,7 @@ int sph_cmd_study(int argc, char **argv) {
           rest /= a.nvalues[k];
         }
       }
-      rc = s.cases ? run_study(&s, &a) : SPH_EXIT_FAIL;
+      rc = s.cases ? run_study(&s, &a) : SPH_EXIT_IO;
     }
   }
   free(s.cases);

@@ -114,6 +114,18 @@ int sph_app_scene_path(const char *arg, char *path, size_t size) {
   return SPH_EXIT_USAGE;
 }
 
+int sph_app_exit_code(sph_status st) {
+  switch (st) {
+  case SPH_OK:
+    return SPH_EXIT_OK;
+  case SPH_ERR_IO:
+  case SPH_ERR_NOMEM:
+    return SPH_EXIT_IO;
+  default:
+    return SPH_EXIT_USAGE;
+  }
+}
+
 void sph_app_print_error(const sph_error *err) {
   char buf[2048];
   sph_error_format(err, buf, sizeof buf);

@@ -69,5 +69,27 @@ done
 [ $? -eq 2 ] && grep -qF "no_such_scene" "$work/stderr" && grep -qE "shipped scenes:.* punch .*twisting_column" "$work/stderr" &&
   [ ! -e outputs/no_such_scene ] && ok || bad "unknown scene name: $(cat "$work/stderr")"
 
+# exit codes, each provoked: 0 stable, 1 unstable, 2 bad input, 3 I/O
+"$sph" run "$tiny" --out "$work/e0" "${quick[@]}" >/dev/null 2>&1
+rc=$?
+[ $rc -eq 0 ] && ok || bad "stable run: exit $rc"
+"$sph" run "$tiny" --out "$work/e1" "${quick[@]}" --set method.cfl=1.5 --set time.end=0.2 \
+  --set output.every=0.05 >"$work/stdout" 2>&1
+rc=$?
+[ $rc -eq 1 ] && grep -q "^verdict: UNSTABLE" "$work/stdout" && ok || bad "unstable run: exit $rc: $(cat "$work/stdout")"
+"$sph" run "$tiny" --out "$work/e2" "${quick[@]}" --set materials.rubber.density=-1 >/dev/null 2>&1
+rc=$?
+[ $rc -eq 2 ] && [ ! -e "$work/e2" ] && ok || bad "bad input: exit $rc"
+touch "$work/plain"
+"$sph" run "$tiny" --out "$work/plain" "${quick[@]}" >/dev/null 2>"$work/stderr"
+rc=$?
+[ $rc -eq 3 ] && grep -qF "$work/plain" "$work/stderr" && ok || bad "--out a file: exit $rc: $(cat "$work/stderr")"
+# a write failing mid-run (file size limit as a full disk): energy.csv
+# outgrows 4 KiB after about 15 rows
+(trap '' XFSZ; ulimit -f 4; "$sph" run "$tiny" --out "$work/e3" "${quick[@]}" \
+  --set time.end=0.3 >/dev/null 2>"$work/stderr")
+rc=$?
+[ $rc -eq 3 ] && grep -qF "$work/e3/" "$work/stderr" && ok || bad "write failure: exit $rc: $(cat "$work/stderr")"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
