@@ -170,12 +170,20 @@ double sph_checkerboard_indicator(const signed char *parity,
 void sph_lattice_parity(const sph_scene *s, const sph_particles *ps,
                         signed char *parity);
 
+/* Which sph ran and how it was called (summary.json, scene_used.yaml). */
+typedef struct sph_provenance {
+  const char *version; /* project version */
+  const char *commit;  /* git describe at configure time, or "unknown" */
+  const char *command; /* the command line, words joined by spaces */
+} sph_provenance;
+
 /* summary.json (keys documented in the README): `sinks` holds the wall
  * seconds of each of the nsinks sinks; mp4_seconds >= 0 adds the time the
  * mp4 took to assemble. */
 sph_status sph_summary_write(const char *path, const sph_sim *sim,
-                             const sph_verdict *v, double wall_seconds,
-                             const sph_sink *sinks, int nsinks,
-                             double mp4_seconds, int completed, sph_error *err);
+                             const sph_provenance *prov, const sph_verdict *v,
+                             double wall_seconds, const sph_sink *sinks,
+                             int nsinks, double mp4_seconds, int completed,
+                             sph_error *err);
 
 #endif

@@ -1,6 +1,6 @@
 /* The sph command: sub-commands and the helpers they share. Only this layer
- * prints and chooses exit codes (0 success, 1 failed run or comparison,
- * 2 bad input or usage). */
+ * prints and chooses exit codes (0 success, 1 unstable run or failed
+ * comparison, 2 bad input or usage, 3 I/O or system failure). */
 #ifndef SPH_APP_IMPL_H
 #define SPH_APP_IMPL_H
 
@@ -11,6 +11,11 @@
 #define SPH_EXIT_OK 0
 #define SPH_EXIT_FAIL 1
 #define SPH_EXIT_USAGE 2
+#define SPH_EXIT_IO 3
+
+/* The exit code of a library status: 3 for I/O and memory, 2 otherwise
+ * (bad input); 0 for SPH_OK. */
+int sph_app_exit_code(sph_status st);
 
 #define SPH_MAX_SETS 64
 
@@ -26,9 +31,54 @@ typedef struct sph_app_args {
   int quiet;          /* --quiet */
 } sph_app_args;
 
-/* Parses argv[first..] into args; prints usage errors; returns 0 or 2. */
-int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
-                       const char *command);
+/* The options of every command (ids of options.c's shared table). */
+enum {
+  SPH_OPT_HELP = 256,
+  SPH_OPT_SET,
+  SPH_OPT_OUT,
+  SPH_OPT_THREADS,
+  SPH_OPT_RESUME_DIR, /* run: --resume DIR */
+  SPH_OPT_RESUME,     /* study: --resume */
+  SPH_OPT_OVERWRITE,
+  SPH_OPT_QUIET,
+  SPH_OPT_VARY,
+  SPH_OPT_REPEAT,
+  SPH_OPT_RESOLUTION,
+  SPH_OPT_DRY_RUN,
+  SPH_OPT_QUICK,
+  SPH_OPT_JSON,
+  SPH_OPT_TOLERANCE,
+  SPH_OPT_SHIFT,
+  SPH_OPT_MAX_FRACTION,
+  SPH_OPT_MAX_CLUSTER,
+  SPH_OPT_DIFF
+};
+
+/* A command for sph_app_getopt: its usage text, the option ids it allows
+ * (0-terminated), and what each option and operand does (0 or 2). */
+typedef struct sph_app_command {
+  const char *name;
+  const char *usage;
+  const int *allowed;
+  int (*option)(void *ctx, int id, const char *value);
+  int (*operand)(void *ctx, const char *arg); /* NULL: none taken */
+} sph_app_command;
+
+/* sph_app_getopt's return when --help or -h printed the usage. */
+#define SPH_APP_HELP (-1)
+
+/* Parses argv[2..] with getopt_long (--opt=V and --opt V); prints usage
+ * errors with the usage; returns 0, 2 or SPH_APP_HELP. */
+int sph_app_getopt(const sph_app_command *cmd, int argc, char **argv,
+                   void *ctx);
+
+/* A count option's value in [1, max], or 2 with a message. */
+int sph_app_count(const char *command, const char *opt, const char *val,
+                  int max, int *out);
+
+/* Parses run's and check's argv into args; returns 0, 2 or SPH_APP_HELP. */
+int sph_app_parse_args(int argc, char **argv, sph_app_args *args,
+                       const sph_app_command *cmd);
 
 /* The shipped scenes folder and the default scene. */
 /* mkdir -p: 0, or -1 with errno set */
@@ -36,6 +86,16 @@ int sph_app_mkdir_p(const char *path);
 
 const char *sph_app_scenes_dir(void);
 const char *sph_app_default_scene(void);
+/* The shipped scene files (NAME.yaml), sorted, each strdup'd; their count. */
+size_t sph_app_scene_files(char **names, size_t max);
+/* SCENE as given on the command line: an existing path, else a shipped
+ * scene's name (NAME or NAME.yaml); returns 0 with the path in path, or
+ * prints the shipped names and returns 2. */
+int sph_app_scene_path(const char *arg, char *path, size_t size);
+
+/* Version, commit and this process's command line (set by main). */
+struct sph_provenance;
+void sph_app_provenance(struct sph_provenance *prov);
 
 /* Prints "sph: file:line:col: key: message" to stderr. */
 void sph_app_print_error(const sph_error *err);

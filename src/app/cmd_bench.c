@@ -428,30 +428,42 @@ static void remove_dir_files(const char *dir) {
   }
 }
 
-int sph_cmd_bench(int argc, char **argv) {
-  int quick = 0, threads = 0;
-  const char *json = NULL;
-  for (int i = 2; i < argc; ++i) {
-    if (!strcmp(argv[i], "--quick"))
-      quick = 1;
-    else if (!strcmp(argv[i], "--json") && i + 1 < argc)
-      json = argv[++i];
-    else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
-      char *end;
-      long n = strtol(argv[++i], &end, 10);
-      if (*end || n < 1 || n > 1024) {
-        fprintf(stderr, "sph bench: --threads takes a count from 1 to 1024\n");
-        return SPH_EXIT_USAGE;
-      }
-      threads = (int)n;
-    } else {
-      fprintf(stderr,
-              "sph bench: unknown option %s\nusage: sph bench "
-              "[--quick] [--json FILE] [--threads N]\n",
-              argv[i]);
-      return SPH_EXIT_USAGE;
-    }
+typedef struct bench_args {
+  int quick, threads;
+  const char *json;
+} bench_args;
+
+static int bench_option(void *ctx, int id, const char *val) {
+  bench_args *b = ctx;
+  switch (id) {
+  case SPH_OPT_QUICK:
+    b->quick = 1;
+    return SPH_EXIT_OK;
+  case SPH_OPT_JSON:
+    b->json = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_THREADS:
+    return sph_app_count("bench", "threads", val, 1024, &b->threads);
+  default:
+    return SPH_EXIT_USAGE;
   }
+}
+
+static const int bench_allowed[] = {SPH_OPT_QUICK, SPH_OPT_JSON,
+                                    SPH_OPT_THREADS, 0};
+static const sph_app_command bench_command = {
+    "bench",
+    "usage: sph bench [--quick] [--json FILE] [--threads N]\n"
+    "  throughput, split and memory of a fixed suite of the shipped scenes\n",
+    bench_allowed, bench_option, NULL};
+
+int sph_cmd_bench(int argc, char **argv) {
+  bench_args b = {0, 0, NULL};
+  int rc = sph_app_getopt(&bench_command, argc, argv, &b);
+  if (rc != SPH_EXIT_OK)
+    return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
+  int quick = b.quick, threads = b.threads;
+  const char *json = b.json;
   const bench_case *cases = quick ? quick_cases : full_cases;
   int ncases = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
                      : (int)(sizeof full_cases / sizeof *full_cases);
@@ -462,7 +474,7 @@ int sph_cmd_bench(int argc, char **argv) {
   if (!mkdtemp(dir)) {
     fprintf(stderr, "sph bench: cannot create a temporary folder: %s\n",
             strerror(errno));
-    return 3;
+    return SPH_EXIT_IO;
   }
   /* the resident set of a process that sets up the smallest scene (the
    * default column, 625 particles) and takes no step: subtracted before
@@ -478,7 +490,7 @@ int sph_cmd_bench(int argc, char **argv) {
   bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
   if (!res) {
     remove_dir_files(dir);
-    return 3;
+    return SPH_EXIT_IO;
   }
   int failed = 0;
   for (int c = 0; c < ncases; ++c)
@@ -492,11 +504,11 @@ int sph_cmd_bench(int argc, char **argv) {
       failed |= !r->ok;
       print_row(&cases[c], r, baseline_kb);
     }
-  int rc = failed ? SPH_EXIT_FAIL : SPH_EXIT_OK;
+  rc = failed ? SPH_EXIT_FAIL : SPH_EXIT_OK;
   if (json && write_json(json, cases, ncases, res, nthr, quick, cores,
                          baseline_kb) != 0) {
     fprintf(stderr, "sph bench: cannot write %s\n", json);
-    rc = 3;
+    rc = SPH_EXIT_IO;
   }
   free(res);
   remove_dir_files(dir);

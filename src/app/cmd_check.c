@@ -48,11 +48,19 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
          peak_rss_mib(), (double)sph_particles_bytes(ps) / 1048576.0);
 }
 
+static const int check_allowed[] = {SPH_OPT_SET, 0};
+static const sph_app_command check_command = {
+    "check",
+    "usage: sph check SCENE [--set key=value]...\n"
+    "  validate SCENE (a file or a shipped scene's name) and print what a\n"
+    "  run would simulate: bodies, method, terms, time step, memory\n",
+    check_allowed, NULL, NULL};
+
 int sph_cmd_check(int argc, char **argv) {
   sph_app_args args;
-  int rc = sph_app_parse_args(argc, argv, 2, &args, "check");
+  int rc = sph_app_parse_args(argc, argv, &args, &check_command);
   if (rc != SPH_EXIT_OK)
-    return rc;
+    return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   if (!args.scene) {
     fprintf(stderr, "sph check: which scene? (usage: sph check SCENE "
                     "[--set k=v]...)\n");

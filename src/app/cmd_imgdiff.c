@@ -13,7 +13,9 @@
 
 static const char *const imgdiff_usage =
     "usage: sph imgdiff A.png B.png [--tolerance N] [--shift N] "
-    "[--max-fraction F] [--max-cluster N] [--diff OUT.png]\n";
+    "[--max-fraction F]\n"
+    "                   [--max-cluster N] [--diff OUT.png]\n"
+    "  compare two images: exit 0 same, 1 different, 2 usage or unreadable\n";
 
 /* An integer option value in [lo, hi]; 0 on a bad value. */
 static int imgdiff_parse_long(const char *s, long lo, long hi, long *out) {
@@ -33,60 +35,76 @@ static int imgdiff_bad_value(const char *opt, const char *val, const char *what,
   return SPH_EXIT_USAGE;
 }
 
-/* Parses argv[2..]; prints usage errors; returns 0 or 2. */
-static int imgdiff_parse(int argc, char **argv, const char **files,
-                         const char **diff_path, sph_imgdiff_options *o) {
-  int nfiles = 0;
-  for (int i = 2; i < argc; ++i) {
-    const char *a = argv[i];
-    int takes = !strcmp(a, "--tolerance") || !strcmp(a, "--shift") ||
-                !strcmp(a, "--max-fraction") || !strcmp(a, "--max-cluster") ||
-                !strcmp(a, "--diff");
-    const char *val = NULL;
-    if (takes) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "sph imgdiff: %s needs a value\n%s", a, imgdiff_usage);
-        return SPH_EXIT_USAGE;
-      }
-      val = argv[++i];
-    }
-    long n;
-    if (!strcmp(a, "--tolerance")) {
-      if (!imgdiff_parse_long(val, 0, 255, &n))
-        return imgdiff_bad_value(a, val, "an integer", 255);
-      o->channel_tolerance = (int)n;
-    } else if (!strcmp(a, "--shift")) {
-      if (!imgdiff_parse_long(val, 0, SPH_IMGDIFF_MAX_SHIFT, &n))
-        return imgdiff_bad_value(a, val, "an integer", SPH_IMGDIFF_MAX_SHIFT);
-      o->shift = (int)n;
-    } else if (!strcmp(a, "--max-cluster")) {
-      if (!imgdiff_parse_long(val, 0, 1L << 30, &n))
-        return imgdiff_bad_value(a, val, "a pixel count", 1L << 30);
-      o->max_cluster = n;
-    } else if (!strcmp(a, "--max-fraction")) {
-      char *end;
-      double f = strtod(val, &end);
-      if (end == val || *end || !isfinite(f) || f < 0.0 || f > 1.0)
-        return imgdiff_bad_value(a, val, "a fraction", 1);
-      o->max_bad_fraction = f;
-    } else if (!strcmp(a, "--diff")) {
-      *diff_path = val;
-    } else if (a[0] == '-' && a[1] == '-') {
-      fprintf(stderr, "sph imgdiff: unknown option %s\n%s", a, imgdiff_usage);
-      return SPH_EXIT_USAGE;
-    } else if (nfiles < 2) {
-      files[nfiles++] = a;
-    } else {
-      fprintf(stderr, "sph imgdiff: more than two images given (%s)\n%s", a,
-              imgdiff_usage);
-      return SPH_EXIT_USAGE;
-    }
+typedef struct imgdiff_parse {
+  const char **files;
+  int nfiles;
+  const char **diff_path;
+  sph_imgdiff_options *o;
+} imgdiff_parse;
+
+static int imgdiff_option(void *ctx, int id, const char *val) {
+  imgdiff_parse *p = ctx;
+  sph_imgdiff_options *o = p->o;
+  long n;
+  switch (id) {
+  case SPH_OPT_TOLERANCE:
+    if (!imgdiff_parse_long(val, 0, 255, &n))
+      return imgdiff_bad_value("--tolerance", val, "an integer", 255);
+    o->channel_tolerance = (int)n;
+    return SPH_EXIT_OK;
+  case SPH_OPT_SHIFT:
+    if (!imgdiff_parse_long(val, 0, SPH_IMGDIFF_MAX_SHIFT, &n))
+      return imgdiff_bad_value("--shift", val, "an integer",
+                               SPH_IMGDIFF_MAX_SHIFT);
+    o->shift = (int)n;
+    return SPH_EXIT_OK;
+  case SPH_OPT_MAX_CLUSTER:
+    if (!imgdiff_parse_long(val, 0, 1L << 30, &n))
+      return imgdiff_bad_value("--max-cluster", val, "a pixel count", 1L << 30);
+    o->max_cluster = n;
+    return SPH_EXIT_OK;
+  case SPH_OPT_MAX_FRACTION: {
+    char *end;
+    double f = strtod(val, &end);
+    if (end == val || *end || !isfinite(f) || f < 0.0 || f > 1.0)
+      return imgdiff_bad_value("--max-fraction", val, "a fraction", 1);
+    o->max_bad_fraction = f;
+    return SPH_EXIT_OK;
   }
-  if (nfiles < 2) {
+  case SPH_OPT_DIFF:
+    *p->diff_path = val;
+    return SPH_EXIT_OK;
+  default:
+    return SPH_EXIT_USAGE;
+  }
+}
+
+static int imgdiff_operand(void *ctx, const char *arg) {
+  imgdiff_parse *p = ctx;
+  if (p->nfiles >= 2) {
+    fprintf(stderr, "sph imgdiff: more than two images given (%s)\n", arg);
+    return SPH_EXIT_USAGE;
+  }
+  p->files[p->nfiles++] = arg;
+  return SPH_EXIT_OK;
+}
+
+static const int imgdiff_allowed[] = {SPH_OPT_TOLERANCE,    SPH_OPT_SHIFT,
+                                      SPH_OPT_MAX_FRACTION, SPH_OPT_MAX_CLUSTER,
+                                      SPH_OPT_DIFF,         0};
+static const sph_app_command imgdiff_command = {
+    "imgdiff", imgdiff_usage, imgdiff_allowed, imgdiff_option, imgdiff_operand};
+
+/* Parses argv[2..]; prints usage errors; returns 0, 2 or SPH_APP_HELP. */
+static int imgdiff_parse_args(int argc, char **argv, const char **files,
+                              const char **diff_path, sph_imgdiff_options *o) {
+  imgdiff_parse p = {files, 0, diff_path, o};
+  int rc = sph_app_getopt(&imgdiff_command, argc, argv, &p);
+  if (rc == SPH_EXIT_OK && p.nfiles < 2) {
     fprintf(stderr, "sph imgdiff: two images are needed\n%s", imgdiff_usage);
     return SPH_EXIT_USAGE;
   }
-  return SPH_EXIT_OK;
+  return rc;
 }
 
 int sph_cmd_imgdiff(int argc, char **argv) {
@@ -94,9 +112,9 @@ int sph_cmd_imgdiff(int argc, char **argv) {
   const char *diff_path = NULL;
   sph_imgdiff_options o;
   sph_imgdiff_defaults(&o);
-  int rc = imgdiff_parse(argc, argv, files, &diff_path, &o);
+  int rc = imgdiff_parse_args(argc, argv, files, &diff_path, &o);
   if (rc != SPH_EXIT_OK)
-    return rc;
+    return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   sph_error err;
   sph_error_clear(&err);
   sph_image a = {0, 0, NULL}, b = {0, 0, NULL}, diff = {0, 0, NULL};

@@ -31,27 +31,40 @@ static void first_comment(const char *path, char *buf, size_t size) {
   fclose(f);
 }
 
-int sph_cmd_list(int argc, char **argv) {
-  if (argc > 2) {
-    fprintf(stderr, "sph list: takes no arguments\n");
-    return SPH_EXIT_USAGE;
-  }
-  const char *dir = sph_app_scenes_dir();
-  DIR *d = opendir(dir);
-  if (!d) {
-    fprintf(stderr, "sph list: cannot open the scenes folder %s\n", dir);
-    return SPH_EXIT_FAIL;
-  }
-  char *names[512];
+static const int list_allowed[] = {0};
+static const sph_app_command list_command = {
+    "list",
+    "usage: sph list\n"
+    "  the shipped scenes (run one by name: sph run NAME), one line each\n",
+    list_allowed, NULL, NULL};
+
+size_t sph_app_scene_files(char **names, size_t max) {
+  DIR *d = opendir(sph_app_scenes_dir());
+  if (!d)
+    return 0;
   size_t n = 0;
   struct dirent *e;
-  while ((e = readdir(d)) && n < 512) {
+  while ((e = readdir(d)) && n < max) {
     size_t len = strlen(e->d_name);
     if (len > 5 && !strcmp(e->d_name + len - 5, ".yaml"))
       names[n++] = strdup(e->d_name);
   }
   closedir(d);
   qsort(names, n, sizeof *names, cmp_str);
+  return n;
+}
+
+int sph_cmd_list(int argc, char **argv) {
+  int rc = sph_app_getopt(&list_command, argc, argv, NULL);
+  if (rc != SPH_EXIT_OK)
+    return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
+  const char *dir = sph_app_scenes_dir();
+  char *names[512];
+  size_t n = sph_app_scene_files(names, 512);
+  if (!n) {
+    fprintf(stderr, "sph list: no scene in the scenes folder %s\n", dir);
+    return SPH_EXIT_IO;
+  }
   int bad = 0;
   for (size_t i = 0; i < n; ++i) {
     char path[1024], comment[256];

@@ -100,7 +100,11 @@ static sph_status write_scene_used(const sph_scene *s, const char *dir,
   sph_status st = sph_atomic_open(&af, path, err);
   if (st != SPH_OK)
     return st;
-  fprintf(af.f, "# %s as run by sph, every default filled in\n", s->path);
+  sph_provenance prov;
+  sph_app_provenance(&prov);
+  fprintf(af.f, "# %s as run by sph %s (commit %s), every default filled in\n",
+          s->path, prov.version, prov.commit);
+  fprintf(af.f, "# command: %s\n", prov.command);
   st = sph_node_write(s->root, af.f, err);
   if (st == SPH_OK)
     st = sph_atomic_commit(&af, err);
@@ -147,11 +151,27 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
   return st;
 }
 
+static const int run_allowed[] = {SPH_OPT_SET,
+                                  SPH_OPT_OUT,
+                                  SPH_OPT_THREADS,
+                                  SPH_OPT_RESUME_DIR,
+                                  SPH_OPT_OVERWRITE,
+                                  SPH_OPT_QUIET,
+                                  0};
+static const sph_app_command run_command = {
+    "run",
+    "usage: sph run [SCENE] [--set key=value]... [--out DIR] [--threads N]\n"
+    "               [--overwrite] [--quiet] [--resume DIR]\n"
+    "  simulate SCENE (a file, or a shipped scene's name: sph list; default\n"
+    "  twisting_column) to its end time; exit 0 stable, 1 unstable, 2 bad\n"
+    "  input or usage, 3 I/O failure\n",
+    run_allowed, NULL, NULL};
+
 int sph_cmd_run(int argc, char **argv) {
   sph_app_args args;
-  int rc = sph_app_parse_args(argc, argv, 2, &args, "run");
+  int rc = sph_app_parse_args(argc, argv, &args, &run_command);
   if (rc != SPH_EXIT_OK)
-    return rc;
+    return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   const char *path = args.scene ? args.scene : sph_app_default_scene();
   sph_scene *scene;
   sph_sim *sim;
@@ -185,12 +205,14 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  if (sph_app_mkdir_p(dir) != 0) {
+  struct stat dst;
+  int made = sph_app_mkdir_p(dir) == 0 && stat(dir, &dst) == 0;
+  if (!made || !S_ISDIR(dst.st_mode)) {
     fprintf(stderr, "sph: cannot create the output folder %s: %s\n", dir,
-            strerror(errno));
+            made ? "a file of that name exists" : strerror(errno));
     sph_sim_destroy(sim);
     sph_scene_destroy(scene);
-    return SPH_EXIT_USAGE;
+    return SPH_EXIT_IO;
   }
   if (args.overwrite && !args.resume)
     remove_previous(dir, scene->name);
@@ -223,7 +245,7 @@ int sph_cmd_run(int argc, char **argv) {
       sph_verdict_destroy(verdict);
       sph_sim_destroy(sim);
       sph_scene_destroy(scene);
-      return SPH_EXIT_USAGE;
+      return SPH_EXIT_USAGE; /* the checkpoint is the run's input */
     }
     if (!args.quiet)
       printf("  resume     %s: t = %.6g s, step %lu, next output %d\n", used,
@@ -306,7 +328,9 @@ int sph_cmd_run(int argc, char **argv) {
   if (verdict && !io_failed) {
     char spath[1200];
     snprintf(spath, sizeof spath, "%s/summary.json", dir);
-    if (sph_summary_write(spath, sim, verdict, wall, sinks, nsinks,
+    sph_provenance prov;
+    sph_app_provenance(&prov);
+    if (sph_summary_write(spath, sim, &prov, verdict, wall, sinks, nsinks,
                           mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
                           completed, &cerr) != SPH_OK) {
       io_failed = 1;
@@ -315,7 +339,7 @@ int sph_cmd_run(int argc, char **argv) {
   }
   if (io_failed) {
     sph_app_print_error(&err);
-    rc = SPH_EXIT_FAIL;
+    rc = sph_app_exit_code(err.code);
   } else if (verdict && !verdict->stable) {
     printf("verdict: UNSTABLE - %s tripped at t = %.6g s: %s (%lu steps, "
            "%.2f s wall)\n",

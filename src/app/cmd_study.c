@@ -29,12 +29,13 @@ typedef struct study_args {
   int dry_run; /* validate and list the cases, run nothing */
 } study_args;
 
-static void usage_line(void) {
-  fprintf(stderr,
-          "usage: sph study SCENE --vary key=v1,v2,... [--vary ...] "
-          "[--set k=v]... [--repeat N] [--threads N] [--resolution KEY] "
-          "[--out DIR] [--resume] [--dry-run]\n");
-}
+static const char study_usage[] =
+    "usage: sph study SCENE --vary key=v1,v2,... [--vary ...] [--set k=v]...\n"
+    "       [--repeat N] [--threads N] [--resolution KEY] [--out DIR]\n"
+    "       [--resume] [--dry-run]\n"
+    "  run every combination of the --vary values, each case its own sph\n"
+    "  run; write results.csv, report.md and plots (default DIR\n"
+    "  outputs/<scene>_study)\n";
 
 /* Splits "key=v1,v2" on the commas outside brackets and quotes. */
 static int split_vary(study *s, study_args *a, const char *arg) {
@@ -96,69 +97,77 @@ static int split_vary(study *s, study_args *a, const char *arg) {
   return SPH_EXIT_OK;
 }
 
-static int parse_count(const char *opt, const char *val, int max, int *out) {
-  char *end;
-  long n = strtol(val, &end, 10);
-  if (*end || n < 1 || n > max) {
-    fprintf(stderr, "sph study: %s takes a count from 1 to %d\n", opt, max);
+typedef struct study_parse {
+  study *s;
+  study_args *a;
+} study_parse;
+
+static int study_option(void *ctx, int id, const char *val) {
+  study *s = ((study_parse *)ctx)->s;
+  study_args *a = ((study_parse *)ctx)->a;
+  switch (id) {
+  case SPH_OPT_VARY:
+    return split_vary(s, a, val);
+  case SPH_OPT_SET:
+    if (a->nsets >= SPH_MAX_SETS - STUDY_MAX_KEYS - 4) {
+      fprintf(stderr, "sph study: too many --set options\n");
+      return SPH_EXIT_USAGE;
+    }
+    a->sets[a->nsets++] = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_REPEAT:
+    return sph_app_count("study", "repeat", val, 100, &s->repeat);
+  case SPH_OPT_THREADS:
+    return sph_app_count("study", "threads", val, 1024, &s->threads);
+  case SPH_OPT_OUT:
+    a->out = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_RESOLUTION:
+    a->resolution = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_RESUME:
+    a->resume = 1;
+    return SPH_EXIT_OK;
+  case SPH_OPT_DRY_RUN:
+    a->dry_run = 1;
+    return SPH_EXIT_OK;
+  default:
     return SPH_EXIT_USAGE;
   }
-  *out = (int)n;
+}
+
+static int study_operand(void *ctx, const char *arg) {
+  study *s = ((study_parse *)ctx)->s;
+  if (s->scene_path) {
+    fprintf(stderr, "sph study: more than one scene given (%s, %s)\n",
+            s->scene_path, arg);
+    return SPH_EXIT_USAGE;
+  }
+  s->scene_path = arg;
   return SPH_EXIT_OK;
 }
 
+static const int study_allowed[] = {
+    SPH_OPT_VARY,    SPH_OPT_SET,     SPH_OPT_REPEAT,
+    SPH_OPT_THREADS, SPH_OPT_OUT,     SPH_OPT_RESOLUTION,
+    SPH_OPT_RESUME,  SPH_OPT_DRY_RUN, 0};
+static const sph_app_command study_command = {
+    "study", study_usage, study_allowed, study_option, study_operand};
+
 static int parse_args(int argc, char **argv, study *s, study_args *a) {
-  for (int i = 2; i < argc; ++i) {
-    const char *o = argv[i];
-    int takes = !strcmp(o, "--vary") || !strcmp(o, "--set") ||
-                !strcmp(o, "--repeat") || !strcmp(o, "--threads") ||
-                !strcmp(o, "--out") || !strcmp(o, "--resolution");
-    const char *val = NULL;
-    if (takes) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "sph study: %s needs a value\n", o);
-        return SPH_EXIT_USAGE;
-      }
-      val = argv[++i];
-    }
-    int rc = SPH_EXIT_OK;
-    if (!strcmp(o, "--vary"))
-      rc = split_vary(s, a, val);
-    else if (!strcmp(o, "--set")) {
-      if (a->nsets >= SPH_MAX_SETS - STUDY_MAX_KEYS - 4) {
-        fprintf(stderr, "sph study: too many --set options\n");
-        return SPH_EXIT_USAGE;
-      }
-      a->sets[a->nsets++] = val;
-    } else if (!strcmp(o, "--repeat"))
-      rc = parse_count(o, val, 100, &s->repeat);
-    else if (!strcmp(o, "--threads"))
-      rc = parse_count(o, val, 1024, &s->threads);
-    else if (!strcmp(o, "--out"))
-      a->out = val;
-    else if (!strcmp(o, "--resolution"))
-      a->resolution = val;
-    else if (!strcmp(o, "--resume"))
-      a->resume = 1;
-    else if (!strcmp(o, "--dry-run"))
-      a->dry_run = 1;
-    else if (o[0] == '-' && o[1] == '-') {
-      fprintf(stderr, "sph study: unknown option %s\n", o);
-      return SPH_EXIT_USAGE;
-    } else if (!s->scene_path)
-      s->scene_path = o;
-    else {
-      fprintf(stderr, "sph study: more than one scene given (%s, %s)\n",
-              s->scene_path, o);
-      return SPH_EXIT_USAGE;
-    }
-    if (rc != SPH_EXIT_OK)
-      return rc;
-  }
+  study_parse p = {s, a};
+  int rc = sph_app_getopt(&study_command, argc, argv, &p);
+  if (rc != SPH_EXIT_OK)
+    return rc;
   if (!s->scene_path || !s->nkeys) {
-    usage_line();
+    fputs(study_usage, stderr);
     return SPH_EXIT_USAGE;
   }
+  static char path[1024];
+  if ((rc = sph_app_scene_path(s->scene_path, path, sizeof path)) !=
+      SPH_EXIT_OK)
+    return rc;
+  s->scene_path = path;
   s->resolution = s->nkeys - 1;
   if (a->resolution) {
     s->resolution = -1;
@@ -453,7 +462,7 @@ static int run_study(study *s, study_args *a) {
   if (sph_app_mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {
     fprintf(stderr, "sph study: cannot write %s: %s\n", s->dir,
             strerror(errno));
-    return SPH_EXIT_FAIL;
+    return SPH_EXIT_IO;
   }
   int todo = 0, done = 0;
   for (int i = 0; i < s->ncases; ++i)
@@ -473,7 +482,7 @@ static int run_study(study *s, study_args *a) {
     if (sph_app_mkdir_p(rundir) != 0) {
       fprintf(stderr, "sph study: cannot create %s: %s\n", rundir,
               strerror(errno));
-      return SPH_EXIT_FAIL;
+      return SPH_EXIT_IO;
     }
     double walls[100];
     for (int r = 0; r < s->repeat; ++r) {
@@ -495,16 +504,17 @@ static int run_study(study *s, study_args *a) {
     if (append_row(s, c, csv) != 0) {
       fprintf(stderr, "sph study: cannot append to %s: %s\n", csv,
               strerror(errno));
-      return SPH_EXIT_FAIL;
+      return SPH_EXIT_IO;
     }
     double elapsed = sph_wtime() - t0;
     progress(s, c, finished, s->ncases, elapsed / done * (todo - done));
   }
   sph_error err;
   sph_error_clear(&err);
-  if (study_report_write(s, &err) != SPH_OK) {
+  sph_status rst = study_report_write(s, &err);
+  if (rst != SPH_OK) {
     sph_app_print_error(&err);
-    return SPH_EXIT_FAIL;
+    return sph_app_exit_code(rst);
   }
   printf("report: %s/report.md, results: %s\n", s->dir, csv);
   sph_status st = study_plots_write(s, &err);
@@ -546,7 +556,7 @@ int sph_cmd_study(int argc, char **argv) {
           rest /= a.nvalues[k];
         }
       }
-      rc = s.cases ? run_study(&s, &a) : SPH_EXIT_FAIL;
+      rc = s.cases ? run_study(&s, &a) : SPH_EXIT_IO;
     }
   }
   free(s.cases);
@@ -555,5 +565,5 @@ int sph_cmd_study(int argc, char **argv) {
     for (int j = 0; j < a.nvalues[k]; ++j)
       free(a.vary_values[k][j]);
   }
-  return rc;
+  return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
 }

@@ -12,6 +12,7 @@
 #include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
+#include "sph/stability.h"
 
 static void usage(FILE *out) {
   fprintf(out,
@@ -43,7 +44,14 @@ static void usage(FILE *out) {
           "  bench [--quick] [--json FILE] [--threads N]\n"
           "                       throughput, split and memory of a fixed "
           "suite\n"
-          "  help                 this text\n");
+          "  help [COMMAND]       this text, or COMMAND's (also COMMAND "
+          "--help, -h)\n"
+          "  --version            version and git commit\n"
+          "\n"
+          "SCENE is a file or a shipped scene's name (sph list). Exit "
+          "status: 0 done\n"
+          "(stable), 1 unstable or different, 2 bad input or usage, 3 I/O "
+          "failure.\n");
 }
 
 const char *sph_app_scenes_dir(void) {
@@ -55,6 +63,67 @@ const char *sph_app_default_scene(void) {
   static char path[1024];
   snprintf(path, sizeof path, "%s/twisting_column.yaml", sph_app_scenes_dir());
   return path;
+}
+
+static char command_line[4096];
+
+/* Joins argv with spaces into command_line (truncated if longer). */
+static void remember_command_line(int argc, char **argv) {
+  size_t len = 0;
+  for (int i = 0; i < argc && len + 1 < sizeof command_line; ++i) {
+    int n = snprintf(command_line + len, sizeof command_line - len, "%s%s",
+                     i ? " " : "", argv[i]);
+    if (n < 0)
+      break;
+    len += (size_t)n;
+  }
+}
+
+void sph_app_provenance(sph_provenance *prov) {
+  prov->version = SPH_VERSION;
+  prov->commit = SPH_GIT_COMMIT;
+  prov->command = command_line;
+}
+
+int sph_app_scene_path(const char *arg, char *path, size_t size) {
+  struct stat st;
+  size_t len = strlen(arg);
+  int has_ext = len > 5 && !strcmp(arg + len - 5, ".yaml");
+  snprintf(path, size, "%s", arg);
+  if (stat(arg, &st) == 0 || strchr(arg, '/'))
+    return SPH_EXIT_OK; /* a path: the loader reports what is wrong */
+  snprintf(path, size, "%s/%s%s", sph_app_scenes_dir(), arg,
+           has_ext ? "" : ".yaml");
+  if (stat(path, &st) == 0)
+    return SPH_EXIT_OK;
+  if (has_ext) {
+    snprintf(path, size, "%s", arg); /* a missing file.yaml */
+    return SPH_EXIT_OK;
+  }
+  char *names[512];
+  size_t n = sph_app_scene_files(names, 512);
+  fprintf(stderr,
+          "sph: %s: no such file and no shipped scene of that name; "
+          "shipped scenes:",
+          arg);
+  for (size_t i = 0; i < n; ++i) {
+    fprintf(stderr, " %.*s", (int)(strlen(names[i]) - 5), names[i]);
+    free(names[i]);
+  }
+  fputc('\n', stderr);
+  return SPH_EXIT_USAGE;
+}
+
+int sph_app_exit_code(sph_status st) {
+  switch (st) {
+  case SPH_OK:
+    return SPH_EXIT_OK;
+  case SPH_ERR_IO:
+  case SPH_ERR_NOMEM:
+    return SPH_EXIT_IO;
+  default:
+    return SPH_EXIT_USAGE;
+  }
 }
 
 void sph_app_print_error(const sph_error *err) {
@@ -76,59 +145,60 @@ int sph_app_mkdir_p(const char *path) {
   return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
 }
 
-int sph_app_parse_args(int argc, char **argv, int first, sph_app_args *args,
-                       const char *command) {
-  memset(args, 0, sizeof *args);
-  for (int i = first; i < argc; ++i) {
-    const char *a = argv[i];
-    const char *val = NULL;
-    int takes = !strcmp(a, "--set") || !strcmp(a, "--out") ||
-                !strcmp(a, "--threads") || !strcmp(a, "--resume");
-    if (takes) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "sph %s: %s needs a value\n", command, a);
-        return SPH_EXIT_USAGE;
-      }
-      val = argv[++i];
-    }
-    if (!strcmp(a, "--set")) {
-      if (args->nsets >= SPH_MAX_SETS) {
-        fprintf(stderr, "sph %s: more than %d --set options\n", command,
-                SPH_MAX_SETS);
-        return SPH_EXIT_USAGE;
-      }
-      args->sets[args->nsets++] = val;
-    } else if (!strcmp(a, "--out")) {
-      args->out = val;
-    } else if (!strcmp(a, "--resume")) {
-      args->resume = val;
-    } else if (!strcmp(a, "--threads")) {
-      char *end;
-      long n = strtol(val, &end, 10);
-      if (*end || n < 1 || n > 1024) {
-        fprintf(stderr, "sph %s: --threads takes a count from 1 to 1024\n",
-                command);
-        return SPH_EXIT_USAGE;
-      }
-      args->threads = (int)n;
-    } else if (!strcmp(a, "--overwrite")) {
-      args->overwrite = 1;
-    } else if (!strcmp(a, "--quiet")) {
-      args->quiet = 1;
-    } else if (a[0] == '-' && a[1] == '-') {
-      fprintf(stderr, "sph %s: unknown option %s\n", command, a);
-      return SPH_EXIT_USAGE;
-    } else if (!args->scene) {
-      args->scene = a;
-    } else {
-      fprintf(stderr, "sph %s: more than one scene given (%s, %s)\n", command,
-              args->scene, a);
+static int args_option(void *ctx, int id, const char *val) {
+  sph_app_args *args = ctx;
+  switch (id) {
+  case SPH_OPT_SET:
+    if (args->nsets >= SPH_MAX_SETS) {
+      fprintf(stderr, "sph: more than %d --set options\n", SPH_MAX_SETS);
       return SPH_EXIT_USAGE;
     }
+    args->sets[args->nsets++] = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_OUT:
+    args->out = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_RESUME_DIR:
+    args->resume = val;
+    return SPH_EXIT_OK;
+  case SPH_OPT_THREADS:
+    return sph_app_count("run", "threads", val, 1024, &args->threads);
+  case SPH_OPT_OVERWRITE:
+    args->overwrite = 1;
+    return SPH_EXIT_OK;
+  case SPH_OPT_QUIET:
+    args->quiet = 1;
+    return SPH_EXIT_OK;
+  default:
+    return SPH_EXIT_USAGE;
   }
-  if (args->threads > 0)
-    omp_set_num_threads(args->threads);
+}
+
+static int args_operand(void *ctx, const char *arg) {
+  sph_app_args *args = ctx;
+  if (args->scene) {
+    fprintf(stderr, "sph: more than one scene given (%s, %s)\n", args->scene,
+            arg);
+    return SPH_EXIT_USAGE;
+  }
+  args->scene = arg;
   return SPH_EXIT_OK;
+}
+
+int sph_app_parse_args(int argc, char **argv, sph_app_args *args,
+                       const sph_app_command *cmd) {
+  memset(args, 0, sizeof *args);
+  sph_app_command c = *cmd;
+  c.option = args_option;
+  c.operand = args_operand;
+  int rc = sph_app_getopt(&c, argc, argv, args);
+  static char path[1024];
+  if (rc == SPH_EXIT_OK && args->scene &&
+      (rc = sph_app_scene_path(args->scene, path, sizeof path)) == SPH_EXIT_OK)
+    args->scene = path;
+  if (rc == SPH_EXIT_OK && args->threads > 0)
+    omp_set_num_threads(args->threads);
+  return rc;
 }
 
 int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
@@ -170,9 +240,20 @@ static void short_spin_wait_policy(char **argv) {
 
 int main(int argc, char **argv) {
   short_spin_wait_policy(argv);
-  if (argc < 2)
-    return sph_cmd_run(argc, argv);
+  remember_command_line(argc, argv);
+  if (argc < 2) {
+    usage(stdout);
+    return SPH_EXIT_OK;
+  }
   const char *cmd = argv[1];
+  /* sph help CMD: that command's --help */
+  char help_flag[] = "--help";
+  char *help_argv[] = {argv[0], argc > 2 ? argv[2] : argv[1], help_flag, NULL};
+  if (!strcmp(cmd, "help") && argc == 3) {
+    argc = 3;
+    argv = help_argv;
+    cmd = argv[1];
+  }
   if (!strcmp(cmd, "run"))
     return sph_cmd_run(argc, argv);
   if (!strcmp(cmd, "check"))
@@ -185,6 +266,10 @@ int main(int argc, char **argv) {
     return sph_cmd_imgdiff(argc, argv);
   if (!strcmp(cmd, "bench"))
     return sph_cmd_bench(argc, argv);
+  if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+    printf("sph %s (commit %s)\n", SPH_VERSION, SPH_GIT_COMMIT);
+    return SPH_EXIT_OK;
+  }
   if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
     usage(stdout);
     return SPH_EXIT_OK;

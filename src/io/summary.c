@@ -29,16 +29,22 @@ static void json_number(FILE *f, double x) {
 }
 
 sph_status sph_summary_write(const char *path, const sph_sim *sim,
-                             const sph_verdict *v, double wall_seconds,
-                             const sph_sink *sinks, int nsinks,
-                             double mp4_seconds, int completed,
+                             const sph_provenance *prov, const sph_verdict *v,
+                             double wall_seconds, const sph_sink *sinks,
+                             int nsinks, double mp4_seconds, int completed,
                              sph_error *err) {
   sph_atomic_file af;
   sph_status st = sph_atomic_open(&af, path, err);
   if (st != SPH_OK)
     return st;
   FILE *f = af.f;
-  fputs("{\n  \"scene\": ", f);
+  fputs("{\n  \"sph\": {\"version\": ", f);
+  json_string(f, prov->version);
+  fputs(", \"commit\": ", f);
+  json_string(f, prov->commit);
+  fputs(", \"command\": ", f);
+  json_string(f, prov->command);
+  fputs("},\n  \"scene\": ", f);
   json_string(f, sim->scene->name);
   fputs(",\n  \"method\": {\"name\": ", f);
   json_string(f, sim->method->name);

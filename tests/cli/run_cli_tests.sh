@@ -103,7 +103,7 @@ grep -q '"first_indicator": null' "$work/run/summary.json" && ok ||
 # (GOMP_SPINCOUNT=1000) then sleeps; a user's OMP_WAIT_POLICY or
 # GOMP_SPINCOUNT is kept as given
 spin_of() { # prints the GOMP_SPINCOUNT/OMP_WAIT_POLICY the running sph sees
-  env "$@" "$sph" run --out "$work/spin" --overwrite --quiet \
+  env "$@" "$sph" run twisting_column --out "$work/spin" --overwrite --quiet \
     --set time.end=1 --set output.png=false --set output.vtk=false \
     >/dev/null 2>&1 &
   local pid=$! seen=""
