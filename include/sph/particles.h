@@ -95,4 +95,31 @@ static inline size_t sph_particles_slot(const sph_particles *ps, size_t j) {
   return ps->slot ? (size_t)ps->slot[j] : j;
 }
 
+/* Mirror (ghost) images of real particles across symmetry planes (seed 000
+ * sec. 8.2, BENCHMARKS D.1): particle n_real + g is the image of src[g].
+ * A vector of the image is S v with S = diag(vsign[3g..3g+2]) when every
+ * plane is a coordinate plane, else S = vmat[9g..9g+8] (row-major: sigma
+ * times the composed reflections I - 2 n n^T); a scalar's departure from its
+ * reference value flips by ssign[g] (sigma). Terms that read neighbours'
+ * values refresh images with sph_mirror_vector/scalar. */
+typedef struct sph_mirror {
+  size_t n_real, n_ghost;
+  const int32_t *src;
+  const signed char *vsign;
+  const double *vmat; /* NULL: coordinate planes only */
+  const signed char *ssign;
+} sph_mirror;
+
+/* Image values of a vector (ncomp 3) or scalar (ncomp 1, about `ref`) field
+ * whose real entries are set. */
+void sph_mirror_vector(const sph_mirror *m, double *v);
+void sph_mirror_scalar(const sph_mirror *m, double *f, double ref);
+
+/* Linear and angular momentum (about the origin) from the mass, velocity
+ * and current position fields. */
+void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]);
+
+/* Monotonic wall clock in seconds. */
+double sph_wtime(void);
+
 #endif

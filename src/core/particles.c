@@ -1,7 +1,11 @@
-/* Particle storage (structure of arrays, fields allocated on demand). */
+/* Particle storage (structure of arrays, fields allocated on demand), the
+ * mirror images of symmetry planes and the momentum sums. */
 #include "sph/particles.h"
 
+#include "sph/tensor.h"
+
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -192,4 +196,55 @@ sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
   free(k);
   free(tmp);
   return SPH_OK;
+}
+
+double sph_wtime(void) { return omp_get_wtime(); }
+
+void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]) {
+  const double *m = ps->field[SPH_FIELD_MASS];
+  const double *v = ps->field[SPH_FIELD_VELOCITY];
+  const double *x = ps->field[SPH_FIELD_POSITION]
+                        ? ps->field[SPH_FIELD_POSITION]
+                        : ps->field[SPH_FIELD_POSITION0];
+  for (int c = 0; c < 3; ++c)
+    lin[c] = ang[c] = 0.0;
+  if (!m || !v)
+    return;
+  for (size_t a = 0; a < ps->n; ++a) {
+    double mv[3] = {m[a] * v[3 * a], m[a] * v[3 * a + 1], m[a] * v[3 * a + 2]};
+    double t[3];
+    sph_vec3_cross(x + 3 * a, mv, t);
+    for (int c = 0; c < 3; ++c) {
+      lin[c] += mv[c];
+      ang[c] += t[c];
+    }
+  }
+}
+
+void sph_mirror_vector(const sph_mirror *m, double *v) {
+  long ng = (long)m->n_ghost;
+  if (m->vmat) {
+#pragma omp parallel for schedule(static)
+    for (long g = 0; g < ng; ++g) {
+      size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;
+      const double *M = m->vmat + 9 * g;
+      for (int c = 0; c < 3; ++c)
+        v[3 * d + c] = M[3 * c] * v[3 * s] + M[3 * c + 1] * v[3 * s + 1] +
+                       M[3 * c + 2] * v[3 * s + 2];
+    }
+    return;
+  }
+#pragma omp parallel for schedule(static)
+  for (long g = 0; g < ng; ++g) {
+    size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;
+    for (int c = 0; c < 3; ++c)
+      v[3 * d + c] = m->vsign[3 * g + c] * v[3 * s + c];
+  }
+}
+
+void sph_mirror_scalar(const sph_mirror *m, double *f, double ref) {
+  long ng = (long)m->n_ghost;
+#pragma omp parallel for schedule(static)
+  for (long g = 0; g < ng; ++g)
+    f[m->n_real + (size_t)g] = ref + m->ssign[g] * (f[(size_t)m->src[g]] - ref);
 }

@@ -11,8 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-double sph_wtime(void) { return omp_get_wtime(); }
-
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err) {
   *out = NULL;
@@ -104,102 +102,4 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
   sim->dt_min = dt < sim->dt_min ? dt : sim->dt_min;
   sim->dt_max = dt > sim->dt_max ? dt : sim->dt_max;
   return SPH_OK;
-}
-
-sph_status sph_sim_add_term(sph_sim *sim, const sph_term_ops *ops, void *data,
-                            sph_error *err) {
-  if (sim->nterms >= SPH_MAX_TERMS)
-    return sph_error_set(err, SPH_ERR_ARG, "more than %d terms", SPH_MAX_TERMS);
-  sph_term *t = &sim->terms[sim->nterms++];
-  memset(t, 0, sizeof *t);
-  t->ops = ops;
-  t->data = data;
-  return SPH_OK;
-}
-
-int sph_sim_add_timer(sph_sim *sim, const char *name) {
-  if (sim->ntimers >= SPH_MAX_TIMERS)
-    return SPH_MAX_TIMERS - 1;
-  sim->timers[sim->ntimers].name = name;
-  return sim->ntimers++;
-}
-
-sph_status sph_sim_terms_rates(sph_sim *sim, sph_stage *stage, sph_error *err) {
-  for (int i = 0; i < sim->nterms; ++i) {
-    sph_term *t = &sim->terms[i];
-    if (!t->ops->rates)
-      continue;
-    double t0 = sph_wtime();
-    sph_status st = t->ops->rates(t, sim, stage, err);
-    t->seconds += sph_wtime() - t0;
-    t->calls++;
-    if (st != SPH_OK)
-      return st;
-  }
-  return SPH_OK;
-}
-
-sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
-                                   sph_error *err) {
-  for (int i = 0; i < sim->nterms; ++i) {
-    sph_term *t = &sim->terms[i];
-    if (!t->ops->constrain)
-      continue;
-    double t0 = sph_wtime();
-    sph_status st = t->ops->constrain(t, sim, state, err);
-    t->seconds += sph_wtime() - t0;
-    t->calls++;
-    if (st != SPH_OK)
-      return st;
-  }
-  return SPH_OK;
-}
-
-void sph_momentum(const sph_particles *ps, double lin[3], double ang[3]) {
-  const double *m = ps->field[SPH_FIELD_MASS];
-  const double *v = ps->field[SPH_FIELD_VELOCITY];
-  const double *x = ps->field[SPH_FIELD_POSITION]
-                        ? ps->field[SPH_FIELD_POSITION]
-                        : ps->field[SPH_FIELD_POSITION0];
-  for (int c = 0; c < 3; ++c)
-    lin[c] = ang[c] = 0.0;
-  if (!m || !v)
-    return;
-  for (size_t a = 0; a < ps->n; ++a) {
-    double mv[3] = {m[a] * v[3 * a], m[a] * v[3 * a + 1], m[a] * v[3 * a + 2]};
-    double t[3];
-    sph_vec3_cross(x + 3 * a, mv, t);
-    for (int c = 0; c < 3; ++c) {
-      lin[c] += mv[c];
-      ang[c] += t[c];
-    }
-  }
-}
-
-void sph_mirror_vector(const sph_mirror *m, double *v) {
-  long ng = (long)m->n_ghost;
-  if (m->vmat) {
-#pragma omp parallel for schedule(static)
-    for (long g = 0; g < ng; ++g) {
-      size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;
-      const double *M = m->vmat + 9 * g;
-      for (int c = 0; c < 3; ++c)
-        v[3 * d + c] = M[3 * c] * v[3 * s] + M[3 * c + 1] * v[3 * s + 1] +
-                       M[3 * c + 2] * v[3 * s + 2];
-    }
-    return;
-  }
-#pragma omp parallel for schedule(static)
-  for (long g = 0; g < ng; ++g) {
-    size_t s = (size_t)m->src[g], d = m->n_real + (size_t)g;
-    for (int c = 0; c < 3; ++c)
-      v[3 * d + c] = m->vsign[3 * g + c] * v[3 * s + c];
-  }
-}
-
-void sph_mirror_scalar(const sph_mirror *m, double *f, double ref) {
-  long ng = (long)m->n_ghost;
-#pragma omp parallel for schedule(static)
-  for (long g = 0; g < ng; ++g)
-    f[m->n_real + (size_t)g] = ref + m->ssign[g] * (f[(size_t)m->src[g]] - ref);
 }
