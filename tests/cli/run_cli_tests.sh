@@ -55,7 +55,7 @@ rc=$?
 # (0.5 m across, 1 m along) resolve nothing at the particle scale (the
 # zig-zag indicator does not judge so coarse a body)
 tiny="$work/tiny.yaml"
-sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
+sed -e 's/count: \[7, 37, 7\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
   -e 's/every: 0.005/every: 0.005/' \
   "$src/scenes/twisting_column.yaml" >"$tiny"
 "$sph" run "$tiny" --out "$work/run" --quiet >"$work/stdout" 2>&1

@@ -9,7 +9,7 @@ src=$2
 
 # a 3 x 7 x 3 column for 0.02 s (as in run_cli_tests.sh)
 tiny="$work/tiny.yaml"
-sed -e 's/count: \[5, 25, 5\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
+sed -e 's/count: \[7, 37, 7\]/count: [3, 7, 3]/' -e 's/end: 0.3/end: 0.02/' \
   -e 's/^stability: .*/stability: {fracture_dp: 3, zigzag_max: 0}/' \
   "$src/scenes/twisting_column.yaml" >"$tiny"
 quick=(--quiet --set output.png=false --set output.vtk=false)

@@ -24,6 +24,18 @@ START_TEST(twisting_column_nearly_incompressible) {
 }
 END_TEST
 
+START_TEST(twisting_column_as_shipped_past_its_end) {
+  /* A1 as the main job runs it (7 x 37 x 7, every output field), to twice
+   * its 0.3 s end: stable, no inversion, energy never above the start */
+  const char *sets[] = {"time.end=0.6"};
+  outcome a = run("twisting_column", sets, 1, 0.005);
+  ck_assert_msg(a.stable && a.t >= 0.6 - 1e-12, "%s", a.reason);
+  ck_assert(a.j_min > 0.5);
+  ck_assert_msg(a.e_max <= a.e0 * (1.0 + 1e-12), "energy %g above %g", a.e_max,
+                a.e0);
+}
+END_TEST
+
 START_TEST(punch_nearly_incompressible) {
   /* A4, nu = 0.499: {p,F,J} and {p,F,H,J} reach the full punch travel */
   const char *pfj[] = {"method.fields=pFJ"};
@@ -50,6 +62,7 @@ int main(void) {
   tcase_set_timeout(tc, 600);
   tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
   tcase_add_test(tc, twisting_column_nearly_incompressible);
+  tcase_add_test(tc, twisting_column_as_shipped_past_its_end);
   tcase_add_test(tc, punch_nearly_incompressible);
   tcase_add_test(tc, coining);
   suite_add_tcase(s, tc);
