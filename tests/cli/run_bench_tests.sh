@@ -24,7 +24,7 @@ threads = {c["threads"] for c in cases}
 assert 1 in threads, threads
 for c in cases:
     assert c["ok"], c
-    for k in ("particles", "steps", "step_seconds", "setup_seconds",
+    for k in ("particles", "steps", "step_seconds", "setup_seconds", "first_step_seconds",
               "particle_steps_per_second_per_thread", "peak_rss_mb"):
         assert isinstance(c[k], (int, float)) and math.isfinite(c[k]) \
             and c[k] > 0, (c["name"], k, c[k])
