@@ -20,6 +20,7 @@ typedef struct sph_ode {
   sph_status (*rhs)(void *ctx, int stage, double t, double dt, sph_error *err);
   sph_status (*constrain)(void *ctx, double t, sph_error *err);
   void *ctx;
+  double seconds; /* wall time of the integrator's own updates, summed */
 } sph_ode;
 
 /* Two-stage TVD Runge-Kutta (seed 000 eq. 43):
@@ -37,6 +38,7 @@ typedef struct sph_leapfrog {
   sph_status (*rates)(void *ctx, double t, sph_error *err);
   sph_status (*constrain)(void *ctx, double t, sph_error *err);
   void *ctx;
+  double seconds; /* wall time of the kicks and the drift, summed */
 } sph_leapfrog;
 
 sph_status sph_leapfrog_step(sph_leapfrog *lf, double t, double dt,

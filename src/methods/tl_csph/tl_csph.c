@@ -68,8 +68,14 @@ static double tl_csph_stable_dt(sph_sim *sim) {
 
 static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
   tl_csph *m = sim->method_data;
+  double s0 = m->lf.seconds;
   SPH_TRY(sph_leapfrog_step(&m->lf, sim->t, dt, err));
-  return tl_check_finite(&m->ref, err);
+  double t0 = sph_wtime();
+  sph_status st = tl_check_finite(&m->ref, err);
+  sph_timer *tm = &sim->timers[m->timer_integration];
+  tm->seconds += m->lf.seconds - s0 + sph_wtime() - t0;
+  tm->calls++;
+  return st;
 }
 
 static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
@@ -134,6 +140,7 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (!m->dp)
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph rates");
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
+  m->timer_integration = sph_sim_add_timer(sim, "time_integration");
   m->lf = (sph_leapfrog){.n = ps->n,
                          .x = m->x,
                          .p = m->p,

@@ -13,6 +13,7 @@ typedef struct tl_csph {
   double *dp;             /* rate of momentum */
   sph_leapfrog lf;
   int timer_force;
+  int timer_integration; /* the integrator's updates, the finite check */
   struct sph_sim *sim;
 } tl_csph;
 

@@ -198,8 +198,14 @@ static double tl_jst_stable_dt(sph_sim *sim) {
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
+  double s0 = m->ode.seconds;
   SPH_TRY(sph_tvd_rk2_step(&m->ode, sim->t, dt, err));
-  return tl_check_finite(&m->ref, err);
+  double t0 = sph_wtime();
+  sph_status st = tl_check_finite(&m->ref, err);
+  sph_timer *tm = &sim->timers[m->timer_integration];
+  tm->seconds += m->ode.seconds - s0 + sph_wtime() - t0;
+  tm->calls++;
+  return st;
 }
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
@@ -397,6 +403,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
         m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
   }
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
+  m->timer_integration = sph_sim_add_timer(sim, "time_integration");
 
   /* integrator storage */
   size_t len[5] = {3 * n, 3 * n, 9 * n, 9 * n, n};

@@ -35,6 +35,7 @@ typedef struct tl_jst {
   double *xmoment; /* X^chi of seed 000 eq. 45 */
   sph_ode ode;
   int timer_force;
+  int timer_integration; /* the integrator's updates, the finite check */
   struct sph_sim *sim;
 } tl_jst;
 
