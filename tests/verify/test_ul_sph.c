@@ -85,11 +85,11 @@ START_TEST(corrected_gradient_is_exact_for_linear_fields) {
       continue;
     double e[3] = {d[0] / r, d[1] / r, 0}, vb[3], dW = sph_kernel_dwdr(&k, r);
     sph_mat3_vec(A, x[b], vb);
-    ul_sph_iact_moment(M, V, r, dW, e);
-    ul_sph_iact_velocity_gradient(L, V, vi, vb, dW, e);
+    ul_sph_iact_moment(M, V, r, dW, e, 3);
+    ul_sph_iact_velocity_gradient(L, V, vi, vb, dW, e, 3);
     /* a rigid rotation v = w x x has e . v_ij = 0 for every pair */
     double w[3] = {-x[b][1], x[b][0], 0};
-    ul_sph_iact_laplacian(rot, V, vi, w, r, dW, e);
+    ul_sph_iact_laplacian(rot, V, vi, w, r, dW, e, 3);
   }
   M[8] = 1.0;
   double B[9], G[9];

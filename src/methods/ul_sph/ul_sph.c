@@ -145,122 +145,172 @@ static void volumes(ul_sph *m) {
     m->vol[a] = m->m[a] / m->rho[a];
 }
 
-/* the acceleration of the state (pressure at rho, shear), into acc and the
+/* The pair loops below are written once as always-inlined bodies and
+ * instantiated per (dimension, shear, stress) so that each outlined OpenMP
+ * loop carries no option branch and 2D runs do 2D arithmetic; the variant is
+ * chosen once at set-up (the results are bit for bit those of the generic
+ * body: the third components of 2D runs are exact zeros). */
+#define UL_INLINE static inline __attribute__((always_inline))
+
+/* the acceleration of particle a (pressure at rho, shear) into acc and the
  * shear part into accs */
-static void accelerations(ul_sph *m, double *acc, double *accs) {
+UL_INLINE void accelerations_particle(ul_sph *m, long a, double *acc,
+                                      double *accs, const int dim,
+                                      const ul_shear shear) {
   const sph_neighbors *nl = m->nl;
   const int32_t *body = m->sim->ps->body;
   const sph_kernel *k = &m->sim->kernel;
-  long n = (long)m->n;
+  double ap[3] = {0, 0, 0}, as[3] = {0, 0, 0}, aa[3] = {0, 0, 0};
+  const double *va = m->v + 3 * a;
+  for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
+    size_t b = (size_t)nl->index[s];
+    const double *e = m->e + 3 * s;
+    double Vb = m->vol[b];
+    double pstar = ul_sph_iact_riemann_pstar(
+        e, va, m->v + 3 * b, m->rho[a], m->rho[b], m->p[a], m->p[b], m->c0[a],
+        m->c0[b], m->limited, dim);
+    if (body[a] != body[b]) { /* bodies push, never pull */
+      if (pstar > 0.0)
+        ul_sph_iact_pressure(ap, Vb, pstar, m->dW[s], e, dim);
+      continue;
+    }
+    ul_sph_iact_pressure(ap, Vb, pstar, m->dW[s], e, dim);
+    if (shear == UL_SHEAR_LAPLACIAN)
+      continue;
+    ul_sph_iact_shear_stress(as, Vb, m->sigma + 9 * a, m->sigma + 9 * b,
+                             m->dW[s], e);
+    if (shear == UL_SHEAR_ARTIFICIAL_STRESS) {
+      double fn = pow(sph_kernel_eval(k, m->r[s]) / m->as_w0, m->as_n);
+      ul_sph_iact_artificial_stress(aa, m->m[b], fn, m->R + 9 * a, m->R + 9 * b,
+                                    m->dW[s], e);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    as[c] = shear == UL_SHEAR_LAPLACIAN ? m->acc_shear[3 * a + c]
+                                        : as[c] / m->rho[a] + aa[c];
+    accs[3 * a + c] = as[c];
+    acc[3 * a + c] = ap[c] / m->rho[a] + as[c];
+  }
+}
+
+/* eq. 11 and, for the shear, eq. 24 (accumulated over dt) or eq. 6-8 with
+ * the velocity gradient eq. 18 / eq. 30-31, for particle a */
+UL_INLINE void continuity_particle(ul_sph *m, long a, double dt, const int dim,
+                                   const ul_shear shear, const int stress) {
+  const sph_neighbors *nl = m->nl;
+  const int32_t *body = m->sim->ps->body;
+  const int pt = m->pressure_term;
+  double dr = 0.0, lap[3] = {0, 0, 0}, M[9] = {0}, L[9] = {0};
+  const double *va = m->v + 3 * a;
+  for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
+    size_t b = (size_t)nl->index[s];
+    const double *e = m->e + 3 * s, *vb = m->v + 3 * b;
+    double Vb = m->vol[b];
+    double du = ul_sph_iact_riemann_du(e, va, vb, m->rho[a], m->rho[b], m->p[a],
+                                       m->p[b], m->c0[a], m->c0[b], pt, dim);
+    if (body[a] != body[b]) { /* contact: only while it pushes */
+      if (ul_sph_iact_riemann_pstar(e, va, vb, m->rho[a], m->rho[b], m->p[a],
+                                    m->p[b], m->c0[a], m->c0[b], m->limited,
+                                    dim) > 0.0)
+        dr += ul_sph_iact_continuity(Vb, du, m->dW[s]);
+      continue;
+    }
+    dr += ul_sph_iact_continuity(Vb, du, m->dW[s]);
+    if (shear == UL_SHEAR_LAPLACIAN)
+      ul_sph_iact_laplacian(lap, Vb, va, vb, m->r[s], m->dW[s], e, dim);
+    if (stress) {
+      if (shear == UL_SHEAR_LAPLACIAN)
+        ul_sph_iact_moment(M, Vb, m->r[s], m->dW[s], e, dim);
+      ul_sph_iact_velocity_gradient(L, Vb, va, vb, m->dW[s], e, dim);
+    }
+  }
+  m->drho[a] = m->rho[a] * dr;
+  if (shear == UL_SHEAR_LAPLACIAN) {
+    double f = dt * 2.0 * m->zeta * m->G[a] / m->rho[a];
+    for (int c = 0; c < 3; ++c)
+      m->acc_shear[3 * a + c] += f * lap[c];
+  }
+  if (!stress)
+    return;
+  if (shear == UL_SHEAR_LAPLACIAN) { /* eq. 30: L = L0 (-B), B = M^-1 */
+    double B[9], L0[9];
+    if (dim == 2)
+      M[8] = 1.0;
+    if (sph_mat3_inverse(M, B) != 0.0) {
+      memcpy(L0, L, sizeof L0);
+      sph_mat3_mul(L0, B, L);
+      for (int k = 0; k < 9; ++k)
+        L[k] = -L[k];
+    }
+  }
+  /* eq. 7-8: sigma += dt 2 G (eps_dot - tr(eps_dot) / d I) */
+  double tr = 0.0;
+  for (int c = 0; c < dim; ++c)
+    tr += L[4 * c];
+  double *S = m->sigma + 9 * a;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) {
+      double eps = 0.5 * (L[3 * r + c] + L[3 * c + r]) - (r == c) * tr / dim;
+      S[3 * r + c] += dt * 2.0 * m->G[a] * eps;
+    }
+}
+
+/* one outlined loop per variant */
+#define UL_SPH_LOOPS(name, DIM, SHEAR, STRESS)                                 \
+  static void accelerations_##name(ul_sph *m, double *acc, double *accs) {     \
+    long n = (long)m->n;                                                       \
+    _Pragma("omp parallel for schedule(static)") for (long a = 0; a < n; ++a)  \
+        accelerations_particle(m, a, acc, accs, DIM, SHEAR);                   \
+  }                                                                            \
+  static void continuity_##name(ul_sph *m, double dt) {                        \
+    long n = (long)m->n;                                                       \
+    _Pragma("omp parallel for schedule(static)") for (long a = 0; a < n; ++a)  \
+        continuity_particle(m, a, dt, DIM, SHEAR, STRESS);                     \
+  }
+
+UL_SPH_LOOPS(enog_2d, 2, UL_SHEAR_LAPLACIAN, 0)
+UL_SPH_LOOPS(enog_2d_stress, 2, UL_SHEAR_LAPLACIAN, 1)
+UL_SPH_LOOPS(enog_3d, 3, UL_SHEAR_LAPLACIAN, 0)
+UL_SPH_LOOPS(enog_3d_stress, 3, UL_SHEAR_LAPLACIAN, 1)
+UL_SPH_LOOPS(og_2d, 2, UL_SHEAR_ORIGINAL, 1)
+UL_SPH_LOOPS(og_3d, 3, UL_SHEAR_ORIGINAL, 1)
+UL_SPH_LOOPS(oas_2d, 2, UL_SHEAR_ARTIFICIAL_STRESS, 1)
+UL_SPH_LOOPS(oas_3d, 3, UL_SHEAR_ARTIFICIAL_STRESS, 1)
+
+/* the variant of a run (OG and OAS always integrate the stress) */
+static ul_sph_loops loops_of(ul_shear shear, int dim, int stress) {
+  static const ul_sph_loops enog[2][2] = {
+      {{accelerations_enog_2d, continuity_enog_2d},
+       {accelerations_enog_2d_stress, continuity_enog_2d_stress}},
+      {{accelerations_enog_3d, continuity_enog_3d},
+       {accelerations_enog_3d_stress, continuity_enog_3d_stress}}};
+  static const ul_sph_loops og[2] = {{accelerations_og_2d, continuity_og_2d},
+                                     {accelerations_og_3d, continuity_og_3d}};
+  static const ul_sph_loops oas[2] = {
+      {accelerations_oas_2d, continuity_oas_2d},
+      {accelerations_oas_3d, continuity_oas_3d}};
+  int d3 = dim == 3;
+  if (shear == UL_SHEAR_LAPLACIAN)
+    return enog[d3][stress != 0];
+  return shear == UL_SHEAR_ORIGINAL ? og[d3] : oas[d3];
+}
+
+/* the acceleration of the state (pressure at rho, shear), into acc and the
+ * shear part into accs */
+static void accelerations(ul_sph *m, double *acc, double *accs) {
   double tp = sph_wtime();
   volumes(m);
   if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
     artificial_stress(m);
-#pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    double ap[3] = {0, 0, 0}, as[3] = {0, 0, 0}, aa[3] = {0, 0, 0};
-    const double *va = m->v + 3 * a;
-    for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-      size_t b = (size_t)nl->index[s];
-      const double *e = m->e + 3 * s;
-      double Vb = m->vol[b];
-      double pstar = ul_sph_iact_riemann_pstar(e, va, m->v + 3 * b, m->rho[a],
-                                               m->rho[b], m->p[a], m->p[b],
-                                               m->c0[a], m->c0[b], m->limited);
-      if (body[a] != body[b]) { /* bodies push, never pull */
-        if (pstar > 0.0)
-          ul_sph_iact_pressure(ap, Vb, pstar, m->dW[s], e);
-        continue;
-      }
-      ul_sph_iact_pressure(ap, Vb, pstar, m->dW[s], e);
-      if (m->shear == UL_SHEAR_LAPLACIAN)
-        continue;
-      ul_sph_iact_shear_stress(as, Vb, m->sigma + 9 * a, m->sigma + 9 * b,
-                               m->dW[s], e);
-      if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS) {
-        double fn = pow(sph_kernel_eval(k, m->r[s]) / m->as_w0, m->as_n);
-        ul_sph_iact_artificial_stress(aa, m->m[b], fn, m->R + 9 * a,
-                                      m->R + 9 * b, m->dW[s], e);
-      }
-    }
-    for (int c = 0; c < 3; ++c) {
-      as[c] = m->shear == UL_SHEAR_LAPLACIAN ? m->acc_shear[3 * a + c]
-                                             : as[c] / m->rho[a] + aa[c];
-      accs[3 * a + c] = as[c];
-      acc[3 * a + c] = ap[c] / m->rho[a] + as[c];
-    }
-  }
+  m->loops.accelerations(m, acc, accs);
   m->sim->timers[m->timer_pressure].seconds += sph_wtime() - tp;
   m->sim->timers[m->timer_pressure].calls++;
 }
 
-/* eq. 11 and, for the shear, eq. 24 (accumulated over dt) or eq. 6-8 with
- * the velocity gradient eq. 18 / eq. 30-31 */
 static void continuity_and_shear(ul_sph *m, double dt) {
-  const sph_neighbors *nl = m->nl;
-  const int32_t *body = m->sim->ps->body;
-  const int dim = m->sim->scene->dimension;
-  const int pt = m->pressure_term;
-  long n = (long)m->n;
   double tp = sph_wtime();
   volumes(m);
-#pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    double dr = 0.0, lap[3] = {0, 0, 0}, M[9] = {0}, L[9] = {0};
-    const double *va = m->v + 3 * a;
-    for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-      size_t b = (size_t)nl->index[s];
-      const double *e = m->e + 3 * s, *vb = m->v + 3 * b;
-      double Vb = m->vol[b];
-      double du =
-          ul_sph_iact_riemann_du(e, va, vb, m->rho[a], m->rho[b], m->p[a],
-                                 m->p[b], m->c0[a], m->c0[b], pt);
-      if (body[a] != body[b]) { /* contact: only while it pushes */
-        if (ul_sph_iact_riemann_pstar(e, va, vb, m->rho[a], m->rho[b], m->p[a],
-                                      m->p[b], m->c0[a], m->c0[b],
-                                      m->limited) > 0.0)
-          dr += ul_sph_iact_continuity(Vb, du, m->dW[s]);
-        continue;
-      }
-      dr += ul_sph_iact_continuity(Vb, du, m->dW[s]);
-      if (m->shear == UL_SHEAR_LAPLACIAN)
-        ul_sph_iact_laplacian(lap, Vb, va, vb, m->r[s], m->dW[s], e);
-      if (m->stress) {
-        if (m->shear == UL_SHEAR_LAPLACIAN)
-          ul_sph_iact_moment(M, Vb, m->r[s], m->dW[s], e);
-        ul_sph_iact_velocity_gradient(L, Vb, va, vb, m->dW[s], e);
-      }
-    }
-    m->drho[a] = m->rho[a] * dr;
-    if (m->shear == UL_SHEAR_LAPLACIAN) {
-      double f = dt * 2.0 * m->zeta * m->G[a] / m->rho[a];
-      for (int c = 0; c < 3; ++c)
-        m->acc_shear[3 * a + c] += f * lap[c];
-    }
-    if (!m->stress)
-      continue;
-    if (m->shear == UL_SHEAR_LAPLACIAN) { /* eq. 30: L = L0 (-B), B = M^-1 */
-      double B[9], L0[9];
-      if (dim == 2)
-        M[8] = 1.0;
-      if (sph_mat3_inverse(M, B) != 0.0) {
-        memcpy(L0, L, sizeof L0);
-        sph_mat3_mul(L0, B, L);
-        for (int k = 0; k < 9; ++k)
-          L[k] = -L[k];
-      }
-    }
-    /* eq. 7-8: sigma += dt 2 G (eps_dot - tr(eps_dot) / d I) */
-    double tr = 0.0;
-    for (int c = 0; c < dim; ++c)
-      tr += L[4 * c];
-    double *S = m->sigma + 9 * a;
-    for (int r = 0; r < dim; ++r)
-      for (int c = 0; c < dim; ++c) {
-        double eps = 0.5 * (L[3 * r + c] + L[3 * c + r]) - (r == c) * tr / dim;
-        S[3 * r + c] += dt * 2.0 * m->G[a] * eps;
-      }
-  }
+  m->loops.continuity(m, dt);
   m->sim->timers[m->timer_shear].seconds += sph_wtime() - tp;
   m->sim->timers[m->timer_shear].calls++;
 }
@@ -577,6 +627,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->stress = m->shear != UL_SHEAR_LAPLACIAN ||
               output_asks(s, SPH_FIELD_STRESS) ||
               output_asks(s, SPH_FIELD_VON_MISES);
+  m->loops = loops_of(m->shear, sim->scene->dimension, m->stress);
   m->x = ps->field[SPH_FIELD_POSITION];
   m->v = ps->field[SPH_FIELD_VELOCITY];
   m->rho = ps->field[SPH_FIELD_DENSITY];

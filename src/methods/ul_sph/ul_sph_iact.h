@@ -16,6 +16,13 @@
 
 #include "sph/tensor.h"
 
+/* a . b over the first dim components (dim a constant where inlined) */
+static inline double ul_sph_iact_dot(const double a[3], const double b[3],
+                                     int dim) {
+  double s = a[0] * b[0] + a[1] * b[1];
+  return dim == 3 ? s + a[2] * b[2] : s;
+}
+
 /* Interface velocity jump and pressure of one pair. */
 typedef struct ul_riemann {
   double du;    /* U_L - U*: half the dissipative velocity jump */
@@ -30,8 +37,8 @@ static inline double ul_sph_iact_riemann_du(const double e[3],
                                             const double vj[3], double rho_i,
                                             double rho_j, double p_i,
                                             double p_j, double c_i, double c_j,
-                                            int pressure_term) {
-  double jump = sph_vec3_dot(vj, e) - sph_vec3_dot(vi, e);
+                                            int pressure_term, int dim) {
+  double jump = ul_sph_iact_dot(vj, e, dim) - ul_sph_iact_dot(vi, e, dim);
   double zL = rho_i * c_i, zR = rho_j * c_j;
   return (zR * jump - (pressure_term ? p_i - p_j : 0.0)) * (1.0 / (zL + zR));
 }
@@ -40,10 +47,12 @@ static inline double ul_sph_iact_riemann_du(const double e[3],
  * only while the pair approaches, growing with its Mach number), else
  * beta = 1 for every pair (the unlimited dissipative solver of the
  * authors' code) */
-static inline double ul_sph_iact_riemann_pstar(
-    const double e[3], const double vi[3], const double vj[3], double rho_i,
-    double rho_j, double p_i, double p_j, double c_i, double c_j, int limited) {
-  double jump = sph_vec3_dot(vj, e) - sph_vec3_dot(vi, e);
+static inline double
+ul_sph_iact_riemann_pstar(const double e[3], const double vi[3],
+                          const double vj[3], double rho_i, double rho_j,
+                          double p_i, double p_j, double c_i, double c_j,
+                          int limited, int dim) {
+  double jump = ul_sph_iact_dot(vj, e, dim) - ul_sph_iact_dot(vi, e, dim);
   double zL = rho_i * c_i, zR = rho_j * c_j;
   double beta = 1.0;
   if (limited) { /* clamped to [0, 1] without branches */
@@ -61,9 +70,9 @@ ul_sph_iact_riemann(const double e[3], const double vi[3], const double vj[3],
                     double c_i, double c_j, int pressure_term, int limited) {
   ul_riemann s;
   s.du = ul_sph_iact_riemann_du(e, vi, vj, rho_i, rho_j, p_i, p_j, c_i, c_j,
-                                pressure_term);
+                                pressure_term, 3);
   s.pstar = ul_sph_iact_riemann_pstar(e, vi, vj, rho_i, rho_j, p_i, p_j, c_i,
-                                      c_j, limited);
+                                      c_j, limited, 3);
   return s;
 }
 
@@ -74,9 +83,9 @@ static inline double ul_sph_iact_continuity(double Vj, double du, double dW) {
 
 /* eq. 12: dv_i / dt += -2 V_j P* / rho_i grad_i W (1 / rho_i later) */
 static inline void ul_sph_iact_pressure(double a[3], double Vj, double pstar,
-                                        double dW, const double e[3]) {
+                                        double dW, const double e[3], int dim) {
   double s = -2.0 * Vj * pstar * dW;
-  for (int c = 0; c < 3; ++c)
+  for (int c = 0; c < dim; ++c)
     a[c] += s * e[c];
 }
 
@@ -109,34 +118,34 @@ static inline void ul_sph_iact_artificial_stress(double a[3], double mj,
 /* eq. 23 without the 2 zeta: V_j (e . v_ij) / r dW e */
 static inline void ul_sph_iact_laplacian(double lap[3], double Vj,
                                          const double vi[3], const double vj[3],
-                                         double r, double dW,
-                                         const double e[3]) {
+                                         double r, double dW, const double e[3],
+                                         int dim) {
   double vij[3] = {vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2]};
-  double s = Vj * sph_vec3_dot(e, vij) / r * dW;
-  for (int c = 0; c < 3; ++c)
+  double s = Vj * ul_sph_iact_dot(e, vij, dim) / r * dW;
+  for (int c = 0; c < dim; ++c)
     lap[c] += s * e[c];
 }
 
 /* eq. 31 before the inverse: M += V_j dW r e (x) e (= V_j r_ij (x) grad W) */
 static inline void ul_sph_iact_moment(double M[9], double Vj, double r,
-                                      double dW, const double e[3]) {
+                                      double dW, const double e[3], int dim) {
   double s = Vj * r * dW;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b)
+  for (int a = 0; a < dim; ++a)
+    for (int b = 0; b < dim; ++b)
       M[3 * a + b] += s * e[a] * e[b];
 }
 
 /* eq. 18 (eq. 30 before the correction B): L_i -= V_j (v_i - v_j) (x)
  * grad_i W; with B = M^-1 applied on the right, -L B is exact for a linear
- * field */
+ * field. `dim` 2 leaves the third row and column as they are (zeros). */
 static inline void ul_sph_iact_velocity_gradient(double L[9], double Vj,
                                                  const double vi[3],
                                                  const double vj[3], double dW,
-                                                 const double e[3]) {
+                                                 const double e[3], int dim) {
   double g[3] = {-(dW * e[0]), -(dW * e[1]), -(dW * e[2])};
-  for (int a = 0; a < 3; ++a) {
+  for (int a = 0; a < dim; ++a) {
     double d = Vj * (vi[a] - vj[a]);
-    for (int b = 0; b < 3; ++b)
+    for (int b = 0; b < dim; ++b)
       L[3 * a + b] += d * g[b];
   }
 }

@@ -13,8 +13,17 @@ typedef enum ul_shear {
   UL_SHEAR_LAPLACIAN          /* SPH-ENOG: eq. 23-24 */
 } ul_shear;
 
+struct ul_sph;
+
+/* the two pair loops of a run, chosen once at set-up */
+typedef struct ul_sph_loops {
+  void (*accelerations)(struct ul_sph *m, double *acc, double *accs);
+  void (*continuity)(struct ul_sph *m, double dt);
+} ul_sph_loops;
+
 typedef struct ul_sph {
   struct sph_sim *sim;
+  ul_sph_loops loops;
   ul_shear shear;
   int dual;          /* dual-criteria stepping (eq. 25-29), else single */
   int pressure_term; /* (P_L - P_R) in U* of the continuity equation */
