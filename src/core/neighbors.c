@@ -148,8 +148,8 @@ typedef struct grid {
   long nc[3];
 } grid;
 
-static void grid_setup(grid *g, const double *x, size_t n, int dim,
-                       double radius) {
+static sph_status grid_setup(grid *g, const double *x, size_t n, int dim,
+                             double radius, sph_error *err) {
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (int c = 0; c < dim; ++c) {
     lo[c] = n ? x[c] : 0.0;
@@ -161,24 +161,37 @@ static void grid_setup(grid *g, const double *x, size_t n, int dim,
       lo[c] = v < lo[c] ? v : lo[c];
       hi[c] = v > hi[c] ? v : hi[c];
     }
-  double cell = radius;
+  for (int c = 0; c < dim; ++c)
+    if (!isfinite(hi[c] - lo[c]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "neighbour search: particle positions are not "
+                           "finite or span more than a double can hold");
+  /* cell counts in double first: a span of 1e19 m over a 1 mm cell does
+   * not fit a long */
+  double cell = radius, limit = (double)(CELLS_PER_PARTICLE_MAX * n + 64);
+  double count[3];
   for (;;) {
     double total = 1.0;
     for (int c = 0; c < 3; ++c) {
-      g->nc[c] = c < dim ? (long)floor((hi[c] - lo[c]) / cell) + 1 : 1;
-      total *= (double)g->nc[c];
+      count[c] = c < dim ? floor((hi[c] - lo[c]) / cell) + 1.0 : 1.0;
+      total *= count[c];
     }
-    if (total <= (double)(CELLS_PER_PARTICLE_MAX * n + 64))
+    if (total <= limit)
       break;
     cell *= 1.5;
   }
+  for (int c = 0; c < 3; ++c)
+    g->nc[c] = (long)count[c];
   memcpy(g->lo, lo, sizeof lo);
   g->cell = cell;
+  return SPH_OK;
 }
 
 static inline long grid_coord(const grid *g, double v, int c) {
-  long k = (long)floor((v - g->lo[c]) / g->cell);
-  return k < 0 ? 0 : (k >= g->nc[c] ? g->nc[c] - 1 : k);
+  double k = floor((v - g->lo[c]) / g->cell);
+  if (!(k > 0.0)) /* also NaN */
+    return 0;
+  return k >= (double)g->nc[c] ? g->nc[c] - 1 : (long)k;
 }
 
 /* Visits the particles of the 3^dim cells around a, in a fixed order,
@@ -222,7 +235,8 @@ sph_status sph_neighbors_build(sph_neighbors *nl, const double *x, size_t n,
   if (st != SPH_OK)
     return st;
   grid g;
-  grid_setup(&g, x, n, dim, radius);
+  if ((st = grid_setup(&g, x, n, dim, radius, err)) != SPH_OK)
+    return st;
   size_t ncell = (size_t)(g.nc[0] * g.nc[1] * g.nc[2]);
 
   /* counting sort of particles into cells (stable: ascending within a cell) */

@@ -1315,6 +1315,29 @@ static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
   return st;
 }
 
+/* Positions a double can tell apart at the particle spacing: beyond 1e9
+ * spacings from the origin a coordinate's rounding step exceeds 1e-7 dp
+ * (kernel sums and neighbour cells lose their meaning). */
+static sph_status check_resolvable(const sph_scene *s, const sph_particles *ps,
+                                   sph_error *err) {
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  double limit = 1e9 * sph_scene_min_spacing(s);
+  for (size_t i = 0; i < ps->n; ++i)
+    for (int c = 0; c < 3; ++c)
+      if (!(fabs(X[3 * i + c]) <= limit)) {
+        const sph_body *bd = &s->bodies[ps->body[i]];
+        char key[32];
+        snprintf(key, sizeof key, "bodies[%d]", (int)ps->body[i]);
+        return sph_error_at(
+            err, SPH_ERR_GEOMETRY, s->path, bd->line, bd->col, key,
+            "a particle at %g m lies more than 1e9 particle spacings (%g m) "
+            "from the origin, where double precision cannot resolve the "
+            "spacing: place the body nearer the origin",
+            X[3 * i + c], sph_scene_min_spacing(s));
+      }
+  return SPH_OK;
+}
+
 sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
                                      sph_error *err) {
   *out = NULL;
@@ -1363,6 +1386,8 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
   free(xs);
   free(vs);
   free(ns);
+  if (st == SPH_OK)
+    st = check_resolvable(s, ps, err);
   if (st == SPH_OK)
     st = check_overlap(s, ps, err);
   /* boundary selections */

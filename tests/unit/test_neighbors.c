@@ -101,6 +101,32 @@ START_TEST(clustered_and_sparse_sets) {
 }
 END_TEST
 
+START_TEST(points_too_far_apart_for_a_long_grid) {
+  /* 1e19 m over 1 mm cells is 1e22 cells along x: the grid coarsens
+   * instead of overflowing (a crash under UBSan before) */
+  double x[12] = {0, 0, 0, 0.0005, 0, 0, 1e19, 0, 0, 1e19, 0.0005, 0};
+  compare(x, 4, 3, 0.001, NULL, SPH_PAIRS_ALL);
+  compare(x, 4, 2, 0.001, NULL, SPH_PAIRS_ALL);
+}
+END_TEST
+
+START_TEST(non_finite_positions_are_refused) {
+  sph_neighbors *nl;
+  sph_error err;
+  double x[6] = {0, 0, 0, INFINITY, 0, 0};
+  ck_assert_int_eq(sph_neighbors_create(&nl, &err), SPH_OK);
+  ck_assert_int_eq(
+      sph_neighbors_build(nl, x, 2, 3, 1.0, NULL, SPH_PAIRS_ALL, &err),
+      SPH_ERR_NUMERIC);
+  x[3] = -1.7e308; /* finite, but the span overflows */
+  x[0] = 1.7e308;
+  ck_assert_int_eq(
+      sph_neighbors_build(nl, x, 2, 3, 1.0, NULL, SPH_PAIRS_ALL, &err),
+      SPH_ERR_NUMERIC);
+  sph_neighbors_destroy(nl);
+}
+END_TEST
+
 START_TEST(same_body_filter) {
   rng_state = 99;
   size_t n = 1000;
@@ -193,6 +219,11 @@ int main(void) {
   tcase_add_test(tc, same_body_filter);
   tcase_add_test(tc, lists_are_symmetric_and_sorted);
   tcase_add_test(tc, rejects_bad_arguments);
+  tcase_add_test(tc, points_too_far_apart_for_a_long_grid);
+  suite_add_tcase(s, tc);
+  /* without floating-point traps: infinities are the input */
+  tc = tcase_create("non-finite");
+  tcase_add_test(tc, non_finite_positions_are_refused);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }
