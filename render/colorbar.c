@@ -91,16 +91,39 @@ void sph_colorbar_labels(const double *ticks, int n,
                ticks[i] == 0.0 ? 0.0 : ticks[i]);
     return;
   }
+  /* engineering form: an exponent that is a multiple of three, so the
+   * mantissas read 1 to 999 ("50e3", "-2.5e6"), never "0.5e7" */
   int e = decade(maxabs);
-  int d = e - k < 1 ? 1 : (e - k > 15 ? 15 : e - k);
-  double scale = pow(10.0, e);
+  int E = 3 * (int)floor(e / 3.0);
+  int d = E - k < 0 ? 0 : (E - k > 15 ? 15 : E - k);
+  double scale = pow(10.0, E);
   for (int i = 0; i < n; ++i) {
     if (ticks[i] == 0.0)
       snprintf(labels[i], SPH_TICK_LABEL_MAX, "0");
     else
       snprintf(labels[i], SPH_TICK_LABEL_MAX, "%.*fe%d", d, ticks[i] / scale,
-               e);
+               E);
   }
+}
+
+void sph_colorbar_end_label(double v, double lo, double hi,
+                            char label[SPH_TICK_LABEL_MAX]) {
+  /* three significant digits of the span, in the ticks' scheme (chosen by
+   * the larger end) */
+  double ref = fmax(fabs(lo), fabs(hi)), span = hi - lo;
+  if (v == 0.0 || !isfinite(v) || !(ref > 0.0)) {
+    snprintf(label, SPH_TICK_LABEL_MAX, "%s", isfinite(v) ? "0" : "nan");
+    return;
+  }
+  int k = span > 0.0 ? decade(span) - 2 : decade(ref) - 2;
+  if (ref >= 1e-3 && ref < 1e5) {
+    int d = k < 0 ? (-k > 15 ? 15 : -k) : 0;
+    snprintf(label, SPH_TICK_LABEL_MAX, "%.*f", d, v);
+    return;
+  }
+  int E = 3 * (int)floor(decade(ref) / 3.0);
+  int d = E - k < 0 ? 0 : (E - k > 15 ? 15 : E - k);
+  snprintf(label, SPH_TICK_LABEL_MAX, "%.*fe%d", d, v / pow(10.0, E), E);
 }
 
 int sph_overlay_font_px(const sph_image *img) {
@@ -180,8 +203,8 @@ static void triangle(sph_image *img, const double v[3][2],
  * the bar's left edge. */
 typedef struct bar_layout {
   int px, n, tick_len, label_dx;
-  double ticks[11];
-  char labels[11][SPH_TICK_LABEL_MAX];
+  double ticks[13];
+  char labels[13][SPH_TICK_LABEL_MAX];
 } bar_layout;
 
 static void layout(const sph_image *img, const sph_colorbar *cb,
@@ -189,8 +212,26 @@ static void layout(const sph_image *img, const sph_colorbar *cb,
   l->px = cb->font_px > 0 ? cb->font_px : sph_overlay_font_px(img);
   int max_ticks = (int)(cb->height / (2.2 * l->px));
   max_ticks = max_ticks < 2 ? 2 : (max_ticks > 11 ? 11 : max_ticks);
-  l->n = sph_colorbar_ticks(cb->min, cb->max, max_ticks, l->ticks);
-  sph_colorbar_labels(l->ticks, l->n, l->labels);
+  int n = sph_colorbar_ticks(cb->min, cb->max, max_ticks, l->ticks);
+  sph_colorbar_labels(l->ticks, n, l->labels);
+  /* the range's ends labelled at the bar's ends; ticks within a label's
+   * height of an end give way */
+  double lo = fmin(cb->min, cb->max), hi = fmax(cb->min, cb->max);
+  double room = hi > lo ? 1.2 * l->px * (hi - lo) / cb->height : 0.0;
+  int m = 0;
+  for (int i = 0; i < n; ++i)
+    if (!(hi > lo) || (l->ticks[i] - lo > room && hi - l->ticks[i] > room)) {
+      l->ticks[m] = l->ticks[i];
+      memmove(l->labels[m], l->labels[i], SPH_TICK_LABEL_MAX);
+      ++m;
+    }
+  if (hi > lo) {
+    l->ticks[m] = lo;
+    sph_colorbar_end_label(lo, lo, hi, l->labels[m++]);
+    l->ticks[m] = hi;
+    sph_colorbar_end_label(hi, lo, hi, l->labels[m++]);
+  }
+  l->n = m;
   l->tick_len = l->px / 3 < 3 ? 3 : l->px / 3;
   l->label_dx = cb->width + 1 + l->tick_len + (l->px / 4 < 2 ? 2 : l->px / 4);
 }

@@ -73,10 +73,11 @@ typedef struct sph_colorbar {
 
 /* Tick labels are formatted in one scheme per bar: fixed notation while every
  * tick magnitude is below 1e5 and the largest is at least 1e-3 (or all are
- * zero), with the decimals the step needs ("0.2", "-1.50"); otherwise one
- * shared power-of-ten exponent E = floor(log10(max |tick|)) written as
- * "-2.0e6", mantissa decimals enough to resolve the step (at least one), and
- * zero as "0". */
+ * zero), with the decimals the step needs ("0.2", "-1.50"); otherwise
+ * engineering form: one shared exponent E, the multiple of three at or
+ * below log10(max |tick|), written as "-2e6" or "350e3", mantissa decimals
+ * enough to resolve the step, and zero as "0". The bar labels its two ends
+ * as well (sph_colorbar_end_label); ticks too near an end give way. */
 #define SPH_TICK_LABEL_MAX 32
 
 /* Nice tick values m * 10^k (m = 1, 2 or 5) inside [min, max]: the finest
@@ -86,6 +87,10 @@ int sph_colorbar_ticks(double min, double max, int max_ticks, double *ticks);
 /* Labels of n ascending ticks from sph_colorbar_ticks in the scheme above. */
 void sph_colorbar_labels(const double *ticks, int n,
                          char (*labels)[SPH_TICK_LABEL_MAX]);
+/* Label of a range end v (lo or hi of the bar's [lo, hi]) to three
+ * significant digits of the span, in the ticks' scheme. */
+void sph_colorbar_end_label(double v, double lo, double hi,
+                            char label[SPH_TICK_LABEL_MAX]);
 /* Vertical bar, max at the top and min at the bottom, the map's end colours
  * in the first and last rows of the rectangle. A 1-pixel outline just
  * outside the rectangle, ticks and labels to its right, a triangle above

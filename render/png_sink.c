@@ -3,13 +3,18 @@
  * the field name and units, the scene name and the time composited on the
  * CPU (colorbar.c, text.c), written to frames/<scene>_NNNN.png.
  *
- * Colour: scalar fields with a signed range use the diverging cool-to-warm
- * map, other fields (and vector/tensor magnitudes) viridis. Range policy:
- * `fixed [min, max]` as given; `symmetric` +-max|f| and `auto` [min, max]
- * grow-only: a frame widens the range when its values exceed it and never
- * narrows it, so colours change only while the field grows (a true
- * run-wide `global` range needs a second pass over the frames and is not
- * done: it behaves as `auto`). NaN values get the map's own NaN colour. The
+ * Colour: the field chooses the map unless `colormap` is given: pressure
+ * (signed about 0) and J (about 1) the diverging cool-to-warm map centred
+ * on that value, every other field (von Mises, density, vector and tensor
+ * magnitudes) viridis over its own range. Range policy: `robust` (the
+ * default) per frame, the 1st to 99th percentile of the frame's values
+ * (centre +- the 99th percentile of |f - centre| for a diverging map), so a
+ * few extreme particles (clamp corners, a punch edge) or an early transient
+ * do not wash the other frames out; `fixed [min, max]` as given;
+ * `symmetric` centre +- max |f - centre| and `auto` [min, max] grow-only: a
+ * frame widens the range when its values exceed it and never narrows it. A
+ * run-wide `global` range needs every frame first; in a run it behaves as
+ * `auto`. NaN values get the map's own NaN colour. The
  * camera frames the bodies' initial bounding box, enlarged by 10 % on each
  * side for the motion, unless the scene gives a position (then the clip
  * range and ortho height are fitted to that box seen from there).
@@ -53,6 +58,7 @@ typedef struct png_frame {
   double *value; /* their colour values (NaN: none) */
   double lo, hi; /* colour range of this frame */
   int clamped_low, clamped_high;
+  sph_view view; /* the camera of this frame (follow) */
   double time;
   int index;
 } png_frame;
@@ -71,9 +77,15 @@ typedef struct png_sink {
   unsigned char *ghost_rim, *ghost_fill; /* their colours */
   /* simulation thread: field, range policy, the two snapshots */
   unsigned char *keep; /* cut: the particles drawn */
+  int follow;          /* refit the camera to the current bodies */
+  int time_decimals;   /* of the time label: those of the output interval */
+  double fit_lo[3], fit_hi[3]; /* the box the camera frames */
+  const sph_scene *scene;
   int field, ncomp;
-  int have_range, symmetric, fixed;
+  int have_range, mode; /* png_range */
+  double centre;        /* diverging maps: the value at the middle */
   double lo, hi;
+  double *work; /* robust: the frame's finite values (n) */
   png_frame slot[2];
   int next; /* the slot the next write fills */
   /* renderer: only the render thread (or, without one, the caller) */
@@ -93,6 +105,44 @@ typedef struct png_sink {
   double busy; /* render thread wall seconds spent on frames */
 } png_sink;
 
+typedef enum png_range {
+  PNG_RANGE_ROBUST,
+  PNG_RANGE_AUTO,
+  PNG_RANGE_SYMMETRIC,
+  PNG_RANGE_FIXED
+} png_range;
+
+/* The k-th smallest of v[0..n) (Hoare's selection; v is reordered). */
+static double select_kth(double *v, size_t n, size_t k) {
+  size_t lo = 0, hi = n - 1;
+  while (lo < hi) {
+    double pivot = v[lo + (hi - lo) / 2];
+    size_t i = lo, j = hi;
+    while (i <= j) {
+      while (v[i] < pivot)
+        ++i;
+      while (v[j] > pivot)
+        --j;
+      if (i <= j) {
+        double t = v[i];
+        v[i] = v[j];
+        v[j] = t;
+        ++i;
+        if (j == 0)
+          break;
+        --j;
+      }
+    }
+    if (k <= j)
+      hi = j;
+    else if (k >= i)
+      lo = i;
+    else
+      break;
+  }
+  return v[k];
+}
+
 /* Scalar value of particle a: the field itself or its magnitude. */
 static double particle_value(const double *f, int nc, size_t a) {
   if (nc == 1)
@@ -107,32 +157,92 @@ static double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/* Share of the frame kept free of particles for the colour bar (right) and
+ * the label block (top) when the camera is fitted. */
+#define PNG_BAR_SHARE 0.2
+#define PNG_LABEL_SHARE 0.12
+
+/* A fitted camera framing [lo, hi] in the part of the frame left of the
+ * colour bar and below the label block (same scale as sph_view_fit's, the
+ * view moved so the box sits in the middle of that part). */
+static void png_fit(const sph_scene *s, const double lo[3], const double hi[3],
+                    sph_view *v) {
+  const sph_png_output *o = &s->output.png;
+  const sph_camera *c = &o->camera;
+  const double deg = 3.14159265358979323846 / 180.0;
+  int W = o->width, H = o->height;
+  int we = (int)((1.0 - PNG_BAR_SHARE) * W),
+      he = (int)((1.0 - PNG_LABEL_SHARE) * H);
+  sph_view_fit(lo, hi, c->given ? c->azimuth : 30.0,
+               c->given ? c->elevation : 20.0, c->given ? c->zoom : 1.0,
+               c->given ? c->orthographic : 0, s->dimension, we, he, v);
+  double f[3], r[3], dist = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    f[k] = v->target[k] - v->eye[k];
+    dist += f[k] * f[k];
+  }
+  dist = sqrt(dist);
+  if (!(dist > 0.0))
+    return;
+  /* the whole frame at the fitted scale */
+  double wpp; /* world units per pixel at the target */
+  if (v->ortho) {
+    v->ortho_height *= (double)H / he;
+    wpp = v->ortho_height / H;
+  } else {
+    double t = tan(0.5 * v->fovy_deg * deg) * H / he;
+    v->fovy_deg = 2.0 * atan(t) / deg;
+    wpp = 2.0 * dist * t / H;
+  }
+  /* move the camera right and up: the box to the left and down */
+  r[0] = f[1] * v->up[2] - f[2] * v->up[1];
+  r[1] = f[2] * v->up[0] - f[0] * v->up[2];
+  r[2] = f[0] * v->up[1] - f[1] * v->up[0];
+  double rl = sqrt(dot3(r, r));
+  if (!(rl > 0.0))
+    return;
+  double right = 0.5 * (W - we) * wpp, up = 0.5 * (H - he) * wpp;
+  for (int k = 0; k < 3; ++k) {
+    double d = right * r[k] / rl + up * v->up[k];
+    v->eye[k] += d;
+    v->target[k] += d;
+  }
+}
+
+/* [lo, hi] padded for the motion: half a spacing and 10 % of each side */
+static void png_pad(double dp, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) {
+    double pad = 0.5 * dp + 0.1 * (hi[k] - lo[k]);
+    lo[k] -= pad;
+    hi[k] += pad;
+  }
+}
+
 /* The frame's camera: a fit of the initial bodies' box (padded for the
- * motion), or the scene's position/target/up with the clip range and ortho
- * height fitted to that box. */
-static void png_view(const sph_sim *sim, sph_view *v) {
+ * motion, returned in lo, hi), or the scene's position/target/up with the
+ * clip range and ortho height fitted to that box. */
+static void png_view(const sph_sim *sim, sph_view *v, double lo[3],
+                     double hi[3]) {
   const sph_scene *s = sim->scene;
   const sph_png_output *o = &s->output.png;
   const sph_camera *c = &o->camera;
-  double lo[3] = {INFINITY, INFINITY, INFINITY};
-  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = INFINITY;
+    hi[k] = -INFINITY;
+  }
   const double *X = sim->ps->field[SPH_FIELD_POSITION0];
   for (size_t a = 0; a < sim->ps->n; ++a)
     for (int k = 0; k < 3; ++k) {
       lo[k] = fmin(lo[k], X[3 * a + k]);
       hi[k] = fmax(hi[k], X[3 * a + k]);
     }
-  for (int k = 0; k < 3; ++k) {
-    double pad = 0.5 * sim->dp + 0.1 * (hi[k] - lo[k]);
-    lo[k] -= pad;
-    hi[k] += pad;
-  }
-  sph_view_fit(lo, hi, c->given ? c->azimuth : 30.0,
-               c->given ? c->elevation : 20.0, c->given ? c->zoom : 1.0,
-               c->given ? c->orthographic : 0, s->dimension, o->width,
-               o->height, v);
-  if (!(c->given && c->has_position))
+  png_pad(sim->dp, lo, hi);
+  if (!(c->given && c->has_position)) {
+    png_fit(s, lo, hi, v);
     return;
+  }
+  sph_view_fit(lo, hi, c->azimuth, c->elevation, c->zoom, c->orthographic,
+               s->dimension, o->width, o->height, v);
   memcpy(v->eye, c->position, sizeof c->position);
   memcpy(v->target, c->target, sizeof c->target);
   memcpy(v->up, c->up, sizeof c->up);
@@ -240,7 +350,8 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
   const sph_node *cam = png_node(s, "camera");
   char msg[1024];
   sph_view v;
-  png_view(sim, &v);
+  double box[2][3];
+  png_view(sim, &v, box[0], box[1]);
   sph_error verr;
   if (sph_view_check(&v, &verr) != SPH_OK) {
     snprintf(msg, sizeof msg, "unusable camera (%s)", verr.message);
@@ -326,7 +437,7 @@ static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
       {m, fr->xyz, (float)(0.5 * dp), p->rgb, plane, 0}};
   sph_error gerr;
   sph_status st =
-      sph_gl_draw_layers(p->gl, &p->view, layers, 3, &p->img, &gerr);
+      sph_gl_draw_layers(p->gl, &fr->view, layers, 3, &p->img, &gerr);
   if (st != SPH_OK)
     return sph_error_at(err, st, path, 0, 0, NULL, "%s", gerr.message);
   /* overlay: colour bar at the right, label block at the top left */
@@ -346,7 +457,8 @@ static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
             sph_colorbar_extent(&p->img, p->text, &cb);
   cb.x = fit < cb.x ? fit : cb.x; /* labels inside small frames */
   sph_colorbar_draw(&p->img, p->text, &cb);
-  snprintf(label, sizeof label, "%s\nt = %.5f s", p->name, fr->time);
+  snprintf(label, sizeof label, "%s\nt = %.*f s", p->name, p->time_decimals,
+           fr->time);
   sph_overlay_label(&p->img, p->text, W / 64, H / 36, label);
   return sph_image_write_png(path, &p->img, err);
 }
@@ -451,23 +563,57 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   sph_field f = (sph_field)o->color_field;
   p->field = f;
   p->ncomp = sph_field_components(f);
-  p->fixed = !strcmp(o->range_mode, "fixed");
-  p->symmetric = !strcmp(o->range_mode, "symmetric");
-  if (p->fixed) {
+  p->mode = !strcmp(o->range_mode, "fixed")       ? PNG_RANGE_FIXED
+            : !strcmp(o->range_mode, "symmetric") ? PNG_RANGE_SYMMETRIC
+            : !strcmp(o->range_mode, "robust")    ? PNG_RANGE_ROBUST
+                                                  : PNG_RANGE_AUTO;
+  if (p->mode == PNG_RANGE_FIXED) {
     p->lo = o->range[0];
     p->hi = o->range[1];
     p->have_range = 1;
   }
-  int signed_field = p->ncomp == 1 &&
-                     (p->symmetric || (p->fixed && p->lo < 0.0 && p->hi > 0.0));
-  p->map = signed_field ? SPH_CMAP_COOL_WARM : SPH_CMAP_VIRIDIS;
+  /* signed fields about their natural centre, the rest one-sided */
+  p->centre = f == SPH_FIELD_PRESSURE   ? 0.0
+              : f == SPH_FIELD_JACOBIAN ? 1.0
+                                        : NAN;
+  if (p->ncomp > 1)
+    p->centre = NAN;
+  if (p->mode == PNG_RANGE_SYMMETRIC && !isfinite(p->centre))
+    p->centre = 0.0;
+  int diverging = isfinite(p->centre);
+  if (p->mode == PNG_RANGE_FIXED)
+    diverging = p->ncomp == 1 && p->lo < (diverging ? p->centre : 0.0) &&
+                p->hi > (diverging ? p->centre : 0.0);
+  p->map = diverging ? SPH_CMAP_COOL_WARM : SPH_CMAP_VIRIDIS;
+  if (o->colormap[0])
+    p->map =
+        !strcmp(o->colormap, "viridis") ? SPH_CMAP_VIRIDIS : SPH_CMAP_COOL_WARM;
+  if (!isfinite(p->centre) && p->map == SPH_CMAP_COOL_WARM)
+    p->centre = 0.0;
+  if (p->map == SPH_CMAP_VIRIDIS)
+    p->centre = NAN;
+  p->work = malloc(n * sizeof *p->work);
+  if (!p->work)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   const char *unit = sph_field_unit(f);
   snprintf(p->title, sizeof p->title, "%s%s%s%s%s", sph_field_name(f),
            p->ncomp > 1 ? " magnitude" : "", unit && *unit ? " [" : "",
            unit ? unit : "", unit && *unit ? "]" : "");
   /* camera, cutaways and the reference outline */
-  png_view(sim, &p->view);
+  png_view(sim, &p->view, p->fit_lo, p->fit_hi);
   SPH_TRY(sph_view_check(&p->view, err));
+  p->scene = sim->scene;
+  p->follow = o->camera.follow && !o->camera.has_position;
+  /* the fewest decimals that write every output time exactly (0.005 -> 3,
+   * 0.0025 -> 4, 2e-6 -> 6), at least one */
+  double every = sim->scene->output.every;
+  p->time_decimals = 1;
+  while (p->time_decimals < 12) {
+    double q = every * pow(10.0, p->time_decimals);
+    if (fabs(q - nearbyint(q)) <= 1e-6 * q)
+      break;
+    p->time_decimals++;
+  }
   SPH_TRY(cut_mask(sim, &p->view, p->keep, err));
   for (size_t a = 0; a < sim->ps->n; ++a)
     p->nkeep += p->keep[a];
@@ -547,6 +693,34 @@ static sph_status png_open_sync(sph_sink *sink, const sph_sim *sim,
   return png_open_as(sink, sim, dir, 0, err);
 }
 
+/* Follow camera: refit when a drawn particle leaves the framed box, or when
+ * the bodies have shrunk to under half of it along every axis (hysteresis:
+ * the view holds still while the motion stays inside). */
+static void png_follow(png_sink *p, const float *xyz, size_t m) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY};
+  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < m; ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = fmin(lo[k], xyz[3 * i + k]);
+      hi[k] = fmax(hi[k], xyz[3 * i + k]);
+    }
+  if (!m)
+    return;
+  int outside = 0, small = 1;
+  for (int k = 0; k < 3; ++k) {
+    double fit = p->fit_hi[k] - p->fit_lo[k];
+    outside |= lo[k] < p->fit_lo[k] || hi[k] > p->fit_hi[k];
+    if (fit > 4.0 * p->dp)
+      small &= hi[k] - lo[k] < 0.5 * fit;
+  }
+  if (!outside && !small)
+    return;
+  png_pad(p->dp, lo, hi);
+  memcpy(p->fit_lo, lo, sizeof lo);
+  memcpy(p->fit_hi, hi, sizeof hi);
+  png_fit(p->scene, lo, hi, &p->view);
+}
+
 /* Copies what frame fr needs into snapshot s and advances the range (frame
  * order, on the simulation thread). A non-finite position fails here, as
  * the sphere pass would, so the frame is not written. */
@@ -557,13 +731,16 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
   size_t n = fr->ps->n, m = 0;
   int nc = p->ncomp;
   double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  size_t nf = 0;
   for (size_t j = 0; j < n; ++j) { /* creation order, as the VTK files */
     size_t a = sph_particles_slot(fr->ps, j);
     double v = field ? particle_value(field, nc, a) : NAN;
     if (isfinite(v)) {
       vmin = fmin(vmin, v);
       vmax = fmax(vmax, v);
-      amax = fmax(amax, fabs(v));
+      amax = fmax(amax, fabs(v - c0));
+      p->work[nf++] = v;
     }
     if (!p->keep[a])
       continue;
@@ -575,16 +752,43 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
     if (!isfinite(s->xyz[i]))
       return sph_error_set(err, SPH_ERR_NUMERIC,
                            "render: sphere %zu has a non-finite centre", i / 3);
-  /* grow-only range from the frames with a varying field */
-  if (!p->fixed && vmax > vmin) {
-    double lo_f = p->symmetric ? -amax : vmin,
-           hi_f = p->symmetric ? amax : vmax;
+  if (p->follow)
+    png_follow(p, s->xyz, m);
+  s->view = p->view;
+  /* the range from the frames with a varying field */
+  int diverging = isfinite(p->centre);
+  if (p->mode == PNG_RANGE_ROBUST && vmax > vmin) {
+    size_t k1 = (size_t)floor(0.01 * (double)(nf - 1) + 0.5);
+    size_t k99 = (size_t)floor(0.99 * (double)(nf - 1) + 0.5);
+    double lo_f, hi_f;
+    if (diverging) {
+      for (size_t i = 0; i < nf; ++i)
+        p->work[i] = fabs(p->work[i] - c0);
+      double w = select_kth(p->work, nf, k99);
+      w = w > 0.0 ? w : amax;
+      lo_f = c0 - w;
+      hi_f = c0 + w;
+    } else {
+      lo_f = select_kth(p->work, nf, k1);
+      hi_f = select_kth(p->work, nf, k99);
+      if (!(hi_f > lo_f)) {
+        lo_f = vmin;
+        hi_f = vmax;
+      }
+    }
+    p->lo = lo_f;
+    p->hi = hi_f;
+    p->have_range = 1;
+  } else if (p->mode != PNG_RANGE_FIXED && p->mode != PNG_RANGE_ROBUST &&
+             vmax > vmin) { /* grow-only */
+    int sym = p->mode == PNG_RANGE_SYMMETRIC;
+    double lo_f = sym ? c0 - amax : vmin, hi_f = sym ? c0 + amax : vmax;
     p->lo = p->have_range ? fmin(p->lo, lo_f) : lo_f;
     p->hi = p->have_range ? fmax(p->hi, hi_f) : hi_f;
     p->have_range = 1;
   }
-  s->lo = p->have_range ? p->lo : -1.0;
-  s->hi = p->have_range ? p->hi : 1.0;
+  s->lo = p->have_range ? p->lo : (diverging ? c0 - 1.0 : 0.0);
+  s->hi = p->have_range ? p->hi : (diverging ? c0 + 1.0 : 1.0);
   /* some finite value outside the range: the bar's end arrows */
   s->clamped_low = vmin < s->lo;
   s->clamped_high = vmax > s->hi;
@@ -636,6 +840,7 @@ static void png_destroy(sph_sink *sink) {
   sph_image_destroy(&p->img);
   free(p->rgb);
   free(p->keep);
+  free(p->work);
   for (int i = 0; i < 2; ++i) {
     free(p->slot[i].xyz);
     free(p->slot[i].value);

@@ -149,13 +149,15 @@ typedef struct sph_camera {
   int has_position;
   double azimuth, elevation, zoom;
   int orthographic;
+  int follow; /* refit to the current bodies (fitted cameras only) */
 } sph_camera;
 
 typedef struct sph_png_output {
   int enabled;
   int width, height;
   int color_field;     /* sph_field */
-  char range_mode[16]; /* auto | symmetric | fixed | global */
+  char range_mode[16]; /* robust | auto | symmetric | fixed | global */
+  char colormap[16];   /* cool-warm | viridis; empty: the field's own */
   double range[2];
   sph_camera camera;
   int mp4;    /* assemble <scene>.mp4 from the frames after the run */

@@ -848,9 +848,9 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   sph_png_output *p = &s->output.png;
   if (!png)
     return SPH_OK;
-  static const char *const keys[] = {"width",  "height", "color", "range",
-                                     "camera", "mp4",    "fps",   "clip",
-                                     "cut",    "ghost",  NULL};
+  static const char *const keys[] = {"width",    "height", "color", "range",
+                                     "colormap", "camera", "mp4",   "fps",
+                                     "clip",     "cut",    "ghost", NULL};
   SPH_TRY(sph_node_check_keys(png, keys, err));
   p->enabled = 1;
   long w, h;
@@ -872,7 +872,7 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
                           "unknown field '%s'", color);
   p->color_field = f;
   sph_node *range = sph_node_child(png, "range");
-  snprintf(p->range_mode, sizeof p->range_mode, "symmetric");
+  snprintf(p->range_mode, sizeof p->range_mode, "robust");
   if (range && range->kind == SPH_NODE_SEQ) {
     range->used = 1;
     SPH_TRY(sph_node_get_doubles(png, "range", 1, 2, p->range, NULL, err));
@@ -882,21 +882,27 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
     snprintf(p->range_mode, sizeof p->range_mode, "fixed");
   } else {
     const char *mode;
-    SPH_TRY(sph_node_get_string(png, "range", 0, "symmetric", &mode, err));
-    if (strcmp(mode, "auto") && strcmp(mode, "symmetric") &&
-        strcmp(mode, "global"))
+    SPH_TRY(sph_node_get_string(png, "range", 0, "robust", &mode, err));
+    if (strcmp(mode, "robust") && strcmp(mode, "auto") &&
+        strcmp(mode, "symmetric") && strcmp(mode, "global"))
       return sph_node_error(sph_node_child(png, "range"), err, SPH_ERR_RANGE,
-                            "range is auto, symmetric, global or [min, max], "
-                            "got '%s'",
+                            "range is robust, auto, symmetric, global or "
+                            "[min, max], got '%s'",
                             mode);
     snprintf(p->range_mode, sizeof p->range_mode, "%s", mode);
   }
+  const char *cmap;
+  SPH_TRY(sph_node_get_string(png, "colormap", 0, "", &cmap, err));
+  if (*cmap && strcmp(cmap, "cool-warm") && strcmp(cmap, "viridis"))
+    return sph_node_error(sph_node_child(png, "colormap"), err, SPH_ERR_RANGE,
+                          "colormap is cool-warm or viridis, got '%s'", cmap);
+  snprintf(p->colormap, sizeof p->colormap, "%s", cmap);
   sph_node *cam;
   SPH_TRY(sph_node_get_map(png, "camera", 0, &cam, err));
   if (cam) {
     static const char *const ckeys[] = {"position",   "target",    "up",
                                         "azimuth",    "elevation", "zoom",
-                                        "projection", NULL};
+                                        "projection", "follow",    NULL};
     SPH_TRY(sph_node_check_keys(cam, ckeys, err));
     sph_camera *c = &p->camera;
     c->given = 1;
@@ -922,6 +928,9 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
                             SPH_ERR_RANGE,
                             "projection is orthographic or perspective");
     c->orthographic = !strcmp(proj, "orthographic");
+    SPH_TRY(sph_node_get_bool(cam, "follow", 0, 1, &c->follow, err));
+  } else {
+    p->camera.follow = 1;
   }
   /* the animation, the cutaway and the reference outline */
   SPH_TRY(sph_node_get_bool(png, "mp4", 0, 1, &p->mp4, err));

@@ -69,8 +69,13 @@ image_case() {
 image_case twisting_column scenes/twisting_column.yaml --set "bodies.0.particles.count=[5, 25, 5]" --set time.end=0.2 --set output.every=0.1
 # A4 punch, 21x11x3, t = 0, 0.007, 0.014 s, seen from the front
 image_case punch scenes/punch.yaml --set "bodies.0.particles.count=[21, 11, 3]" --set time.end=0.014 --set output.every=0.007 --set "output.png.camera={azimuth: 15, elevation: 10, zoom: 0.7}"
-# A8 colliding rings (ul-sph, ENOG), dp 0.002, t = 0, 0.003, 0.006 s
-image_case colliding_rings scenes/colliding_rings.yaml --set bodies.0.particles.spacing=0.002 --set bodies.1.particles.spacing=0.002 --set time.end=0.006 --set output.every=0.003
+# A8 colliding rings (ul-sph, ENOG), dp 0.002, through the rebound to
+# 0.03 s: the follow camera keeps both rings in view, left of the bar
+image_case colliding_rings scenes/colliding_rings.yaml --set bodies.0.particles.spacing=0.002 --set bodies.1.particles.spacing=0.002 --set time.end=0.03 --set output.every=0.015
+# one-sided fields: von Mises (viridis over its own robust range) and J
+# (cool-to-warm centred on 1), the twisting column at t = 0.2 s
+image_case twisting_column_von_mises scenes/twisting_column.yaml --set "bodies.0.particles.count=[5, 25, 5]" --set time.end=0.2 --set output.every=0.2 --set output.png.color=von_mises
+image_case twisting_column_J scenes/twisting_column.yaml --set "bodies.0.particles.count=[5, 25, 5]" --set time.end=0.2 --set output.every=0.2 --set output.png.color=J
 
 echo "$fails failed"
 [ $fails -eq 0 ]

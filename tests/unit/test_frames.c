@@ -134,6 +134,50 @@ START_TEST(cut_half) {
 }
 END_TEST
 
+/* pixels that differ between two frames in the part right of 0.8 W that
+ * the layout keeps for the colour bar and its labels */
+static long bar_strip_changes(const sph_image *a, const sph_image *b) {
+  long n = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 4 * W / 5; x < W; ++x)
+      n += memcmp(px(a, x, y), px(b, x, y), 3) != 0;
+  return n;
+}
+
+START_TEST(follow_camera_keeps_the_bar_clear) {
+  /* 150 m/s for 0.02 s: the block travels three times its width; the
+   * follow camera (default) keeps it whole and left of the colour bar */
+  sph_image followed, fixed, still;
+  render("follow", "", 150.0, &followed);
+  render("still", "", 0.0, &still);
+  int x0, x1;
+  long n = 0;
+  x0 = W, x1 = -1;
+  for (int y = H / 5; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      if (!is_background(px(&followed, x, y)) && x < 4 * W / 5) {
+        n++;
+        x0 = x < x0 ? x : x0;
+        x1 = x > x1 ? x : x1;
+      }
+  ck_assert_msg(n > 1000 && x0 > 0, "followed: %ld px from column %d", n, x0);
+  /* the bar strip holds the overlay only: as in the frame of the block at
+   * rest (the same zero pressure, so the same bar and labels) */
+  ck_assert_int_eq(bar_strip_changes(&followed, &still), 0);
+  /* the same run with the camera held on the start: the block has left
+   * the free part of the frame */
+  render("fixed", ", camera: {follow: false}", 150.0, &fixed);
+  long left = 0;
+  for (int y = H / 5; y < H; ++y)
+    for (int x = 0; x < 4 * W / 5; ++x)
+      left += !is_background(px(&fixed, x, y));
+  ck_assert_msg(left < n / 2, "held camera: %ld px in the free part", left);
+  sph_image_destroy(&followed);
+  sph_image_destroy(&fixed);
+  sph_image_destroy(&still);
+}
+END_TEST
+
 START_TEST(ghost_outline) {
   /* 10 m/s for 0.02 s: the block moves one spacing (0.2 m) to the right */
   sph_image plain, ghost;
@@ -178,6 +222,7 @@ int main(void) {
   tcase_add_test(tc, clip_plane);
   tcase_add_test(tc, cut_half);
   tcase_add_test(tc, ghost_outline);
+  tcase_add_test(tc, follow_camera_keeps_the_bar_clear);
   suite_add_tcase(s, tc);
   int rc = sph_test_run(s);
   char cmd[256];

@@ -144,13 +144,33 @@ START_TEST(tick_cases) {
   expect_ticks(0.0, 1.0, 6, 6, (double[]){0, 0.2, 0.4, 0.6, 0.8, 1.0},
                (const char *[]){"0.0", "0.2", "0.4", "0.6", "0.8", "1.0"});
   expect_ticks(-3e6, 7.5e6, 6, 5, (double[]){-2e6, 0, 2e6, 4e6, 6e6},
-               (const char *[]){"-2.0e6", "0", "2.0e6", "4.0e6", "6.0e6"});
+               (const char *[]){"-2e6", "0", "2e6", "4e6", "6e6"});
   expect_ticks(7.5e6, -3e6, 6, 5, (double[]){-2e6, 0, 2e6, 4e6, 6e6},
-               (const char *[]){"-2.0e6", "0", "2.0e6", "4.0e6", "6.0e6"});
+               (const char *[]){"-2e6", "0", "2e6", "4e6", "6e6"});
+  /* engineering form: mantissas 1 to 999, never "0.5e5" */
+  expect_ticks(1e4, 4.3e5, 5, 4, (double[]){1e5, 2e5, 3e5, 4e5},
+               (const char *[]){"100e3", "200e3", "300e3", "400e3"});
   expect_ticks(0.0, 100.0, 5, 3, (double[]){0, 50, 100},
                (const char *[]){"0", "50", "100"});
   expect_ticks(-0.013, 0.0042, 5, 3, (double[]){-0.01, -0.005, 0},
                (const char *[]){"-0.010", "-0.005", "0.000"});
+}
+END_TEST
+
+START_TEST(bar_end_labels) {
+  /* the range's ends, three significant digits of the span, the ticks'
+   * scheme */
+  char l[SPH_TICK_LABEL_MAX];
+  sph_colorbar_end_label(4.29e5, 1.34e4, 4.29e5, l);
+  ck_assert_str_eq(l, "429e3");
+  sph_colorbar_end_label(1.34e4, 1.34e4, 4.29e5, l);
+  ck_assert_str_eq(l, "13e3");
+  sph_colorbar_end_label(-3.2945e6, -3.2945e6, 3.2945e6, l);
+  ck_assert_str_eq(l, "-3.29e6");
+  sph_colorbar_end_label(0.8512, 0.8512, 1.1488, l);
+  ck_assert_str_eq(l, "0.851");
+  sph_colorbar_end_label(0.0, 0.0, 2.0, l);
+  ck_assert_str_eq(l, "0");
 }
 END_TEST
 
@@ -170,7 +190,7 @@ START_TEST(tick_tiny_and_degenerate) {
   expect_ticks(5.0, 5.0, 6, 1, (double[]){5.0}, (const char *[]){"5.000"});
   expect_ticks(0.0, 0.0, 6, 1, (double[]){0.0}, (const char *[]){"0"});
   expect_ticks(2.5e5, 2.5e5, 6, 1, (double[]){2.5e5},
-               (const char *[]){"2.500e5"});
+               (const char *[]){"250.0e3"});
   double t[8];
   ck_assert_int_eq(sph_colorbar_ticks(1.0, 1.0 + 1e-15, 6, t), 1);
   ck_assert_int_eq(sph_colorbar_ticks(0.0, 1.0, 0, t), 0);
@@ -500,6 +520,7 @@ int main(void) {
   tcase_add_test(tc, colormap_lightness);
   tcase_add_test(tc, tick_cases);
   tcase_add_test(tc, tick_tiny_and_degenerate);
+  tcase_add_test(tc, bar_end_labels);
   tcase_add_test(tc, tick_properties);
   tcase_add_test(tc, text_width);
   tcase_add_test(tc, text_draw_box);
