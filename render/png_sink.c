@@ -143,6 +143,12 @@ static double select_kth(double *v, size_t n, size_t k) {
   return v[k];
 }
 
+double sph_png_field_centre(int field) {
+  return field == SPH_FIELD_PRESSURE   ? 0.0
+         : field == SPH_FIELD_JACOBIAN ? 1.0
+                                       : NAN;
+}
+
 /* Scalar value of particle a: the field itself or its magnitude. */
 static double particle_value(const double *f, int nc, size_t a) {
   if (nc == 1)
@@ -573,9 +579,7 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
     p->have_range = 1;
   }
   /* signed fields about their natural centre, the rest one-sided */
-  p->centre = f == SPH_FIELD_PRESSURE   ? 0.0
-              : f == SPH_FIELD_JACOBIAN ? 1.0
-                                        : NAN;
+  p->centre = sph_png_field_centre(f);
   if (p->ncomp > 1)
     p->centre = NAN;
   if (p->mode == PNG_RANGE_SYMMETRIC && !isfinite(p->centre))

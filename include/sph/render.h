@@ -29,6 +29,10 @@ extern const sph_sink_ops sph_png_sink_sync_ops;
  * .camera.position or .clip) with file:line:col. SPH_OK without a block. */
 sph_status sph_png_check(const sph_sim *sim, sph_error *err);
 
+/* The value a field's diverging colour map is centred on: 0 for pressure,
+ * 1 for J; NaN for the fields drawn one-sided (viridis). */
+double sph_png_field_centre(int field);
+
 /* What sph_mp4_assemble did. */
 typedef struct sph_mp4_info {
   char path[1100]; /* <dir>/<scene>.mp4 */

@@ -51,7 +51,12 @@ enum {
   SPH_OPT_SHIFT,
   SPH_OPT_MAX_FRACTION,
   SPH_OPT_MAX_CLUSTER,
-  SPH_OPT_DIFF
+  SPH_OPT_DIFF,
+  SPH_OPT_FIELD,
+  SPH_OPT_RANGE,
+  SPH_OPT_WIDTH,
+  SPH_OPT_HEIGHT,
+  SPH_OPT_MP4
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows
@@ -117,5 +122,8 @@ int sph_cmd_imgdiff(int argc, char **argv);
 /* sph bench [--quick] [--json FILE] [--threads N]: 0 every case ran, 1 a
  * case failed, 2 usage, 3 I/O */
 int sph_cmd_bench(int argc, char **argv);
+/* sph render RUN [options]: 0 done, 2 bad input (missing or damaged files),
+ * 3 I/O */
+int sph_cmd_render(int argc, char **argv);
 
 #endif

@@ -44,6 +44,10 @@ static void usage(FILE *out) {
           "  bench [--quick] [--json FILE] [--threads N]\n"
           "                       throughput, split and memory of a fixed "
           "suite\n"
+          "  render RUN_DIR [--field F] [--range R] [--width W] [--height H]\n"
+          "         [--set output.png.KEY=V]... [--out DIR] [--mp4]\n"
+          "                       draw a finished run's frames again from "
+          "its .vtp files\n"
           "  help [COMMAND]       this text, or COMMAND's (also COMMAND "
           "--help, -h)\n"
           "  --version            version and git commit\n"
@@ -266,6 +270,8 @@ int main(int argc, char **argv) {
     return sph_cmd_imgdiff(argc, argv);
   if (!strcmp(cmd, "bench"))
     return sph_cmd_bench(argc, argv);
+  if (!strcmp(cmd, "render"))
+    return sph_cmd_render(argc, argv);
   if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
     printf("sph %s (commit %s)\n", SPH_VERSION, SPH_GIT_COMMIT);
     return SPH_EXIT_OK;

@@ -29,6 +29,11 @@ static const struct option all_options[] = {
     {"max-fraction", required_argument, NULL, SPH_OPT_MAX_FRACTION},
     {"max-cluster", required_argument, NULL, SPH_OPT_MAX_CLUSTER},
     {"diff", required_argument, NULL, SPH_OPT_DIFF},
+    {"field", required_argument, NULL, SPH_OPT_FIELD},
+    {"range", required_argument, NULL, SPH_OPT_RANGE},
+    {"width", required_argument, NULL, SPH_OPT_WIDTH},
+    {"height", required_argument, NULL, SPH_OPT_HEIGHT},
+    {"mp4", no_argument, NULL, SPH_OPT_MP4},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 
