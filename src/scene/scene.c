@@ -834,15 +834,19 @@ static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
 
 static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   sph_node *png = sph_node_child(out, "png");
-  /* png: false turns the frames off (sph study, --set output.png=false) */
+  /* png: false turns the frames off (sph study, --set output.png=false);
+   * png: true is png: {} (frames with the defaults) */
   if (png && png->kind == SPH_NODE_SCALAR && !png->quoted) {
     int on;
-    SPH_TRY(sph_node_as_bool(png, &on, err));
+    if (sph_node_as_bool(png, &on, err) != SPH_OK)
+      return sph_node_error(png, err, SPH_ERR_TYPE,
+                            "expected a mapping, true or false");
     png->used = 1;
     if (!on)
       return SPH_OK;
-    return sph_node_error(png, err, SPH_ERR_TYPE,
-                          "expected a mapping or false");
+    free(png->value);
+    png->value = NULL;
+    png->kind = SPH_NODE_MAP;
   }
   SPH_TRY(sph_node_get_map(out, "png", 0, &png, err));
   sph_png_output *p = &s->output.png;

@@ -91,5 +91,14 @@ rc=$?
 rc=$?
 [ $rc -eq 3 ] && grep -qF "$work/e3/" "$work/stderr" && ok || bad "write failure: exit $rc: $(cat "$work/stderr")"
 
+# output.png=true: frames with the defaults; anything but a mapping or a
+# boolean refused naming the key
+"$sph" run "$tiny" --out "$work/pngtrue" --quiet --set output.png=true >/dev/null 2>&1
+[ $? -eq 0 ] && ls "$work/pngtrue/frames/"*_0000.png >/dev/null 2>&1 &&
+  "$sph" check "$work/pngtrue/scene_used.yaml" >/dev/null 2>&1 && ok || bad "output.png=true"
+"$sph" check "$tiny" --set output.png=maybe 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -qF "output.png: expected a mapping, true or false" "$work/stderr" && ok ||
+  bad "output.png=maybe: $(cat "$work/stderr")"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
