@@ -68,6 +68,7 @@ typedef struct sph_method_ops {
   const char *title;              /* readable name */
   const char *reference;          /* seed sections and equations */
   int conserves_angular_momentum; /* to round-off, for a free body */
+  unsigned long fields;           /* the output fields it fills: bit 1ul << f */
   /* validates the method block, requires fields, creates its terms */
   sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);
   double (*stable_dt)(sph_sim *sim);

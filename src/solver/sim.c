@@ -11,6 +11,62 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The node of an output.fields / probe fields entry naming `name`, or the
+ * list itself. */
+static const sph_node *field_node(const sph_node *list, const char *name) {
+  for (size_t i = 0; list && i < list->count; ++i)
+    if (list->items[i]->value && !strcmp(list->items[i]->value, name))
+      return list->items[i];
+  return list;
+}
+
+/* Every field an output asks for is one the method fills (its ops table's
+ * `fields`); else the request is refused at its key with the method's list
+ * (a field would otherwise be left out of the files without a word). */
+static sph_status check_output_fields(const sph_sim *sim, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_output *o = &s->output;
+  const sph_node *out = sph_node_child(s->root, "output");
+  char have[512] = "";
+  for (int f = 0; f < SPH_FIELD_COUNT; ++f)
+    if (sim->method->fields & 1ul << f) {
+      strncat(have, have[0] ? ", " : "", sizeof have - strlen(have) - 1);
+      strncat(have, sph_field_name((sph_field)f),
+              sizeof have - strlen(have) - 1);
+    }
+  for (size_t k = 0; k <= o->nprobes + 1; ++k) {
+    const int *fields = NULL;
+    int n = 0;
+    const sph_node *at = NULL;
+    if (k == 0) { /* output.fields */
+      fields = o->fields, n = o->nfields;
+      at = out ? sph_node_child(out, "fields") : NULL;
+    } else if (k == 1) { /* the frames' colour */
+      fields = o->png.enabled ? &o->png.color_field : NULL, n = fields != NULL;
+      const sph_node *png = out ? sph_node_child(out, "png") : NULL;
+      at = png ? sph_node_child(png, "color") : NULL;
+      at = at ? at : png;
+    } else { /* a probe */
+      fields = o->probes[k - 2].fields, n = o->probes[k - 2].nfields;
+      const sph_node *pr = out ? sph_node_child(out, "probes") : NULL;
+      at = pr && k - 2 < pr->count ? sph_node_child(pr->items[k - 2], "fields")
+                                   : pr;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (sim->method->fields & 1ul << fields[i])
+        continue;
+      const char *name = sph_field_name((sph_field)fields[i]);
+      const sph_node *node = k == 1 ? at : field_node(at, name);
+      node = node ? node : (out ? out : s->root);
+      return sph_node_error(node, err, SPH_ERR_ARG,
+                            "%s does not provide the field '%s' (it provides "
+                            "%s)",
+                            sim->method->name, name, have);
+    }
+  }
+  return SPH_OK;
+}
+
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err) {
   *out = NULL;
@@ -58,6 +114,8 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)
     st = method->setup(sim, scene->method, err);
+  if (st == SPH_OK)
+    st = check_output_fields(sim, err);
   /* the time step rule (a wave speed per particle) is work of every step */
   if (st == SPH_OK)
     sim->timer_stable_dt = sph_sim_add_timer(sim, "stable_dt");

@@ -159,7 +159,7 @@ START_TEST(overrides) {
 }
 END_TEST
 
-/* output.png: a block turns frames on, false keeps them off */
+/* output.png: a block or true turns frames on, false keeps them off */
 START_TEST(png_off) {
   sph_scene *s;
   sph_error err;
@@ -171,7 +171,12 @@ START_TEST(png_off) {
   ck_assert_int_eq(load_text(good, &s, off, 2, &err), SPH_OK);
   ck_assert_int_eq(s->output.png.enabled, 0);
   sph_scene_destroy(s);
-  const char *bad[] = {"output.png=true"};
+  const char *yes[] = {"output.png=true"};
+  ck_assert_int_eq(load_text(good, &s, yes, 1, &err), SPH_OK);
+  ck_assert_int_eq(s->output.png.enabled, 1);
+  ck_assert_int_eq(s->output.png.width, 1280);
+  sph_scene_destroy(s);
+  const char *bad[] = {"output.png=7"};
   ck_assert_int_eq(load_text(good, &s, bad, 1, &err), SPH_ERR_TYPE);
   ck_assert_str_eq(err.key, "output.png");
 }

@@ -508,16 +508,6 @@ static int output_asks(const sph_scene *s, sph_field f) {
 }
 
 static sph_status check_scene(const sph_scene *s, sph_error *err) {
-  static const sph_field none[] = {SPH_FIELD_MOMENTUM, SPH_FIELD_DEFGRAD,
-                                   SPH_FIELD_COFACTOR, SPH_FIELD_PK1};
-  for (size_t i = 0; i < sizeof none / sizeof *none; ++i)
-    if (output_asks(s, none[i])) {
-      sph_node *out = sph_node_child(s->root, "output");
-      return sph_node_error(out ? out : s->root, err, SPH_ERR_ARG,
-                            "ul-sph has no field '%s' (it carries position, "
-                            "velocity, density and stress)",
-                            sph_field_name(none[i]));
-    }
   for (size_t k = 0; k < s->nboundaries; ++k) {
     const sph_boundary *b = &s->boundaries[k];
     if (b->kind == SPH_BC_SYMMETRY || b->kind == SPH_BC_SKEW_SYMMETRY)
@@ -685,6 +675,12 @@ const sph_method_ops ul_sph_method_ops = {
              "essentially non-hourglass)",
     .reference = "seed 002 (Zhang et al. 2024) eq. 4-18, 23-31",
     .conserves_angular_momentum = 0, /* seed 002 sec. 6.10 */
+    .fields = 1ul << SPH_FIELD_POSITION0 | 1ul << SPH_FIELD_POSITION |
+              1ul << SPH_FIELD_VELOCITY | 1ul << SPH_FIELD_ACCELERATION |
+              1ul << SPH_FIELD_VOLUME0 | 1ul << SPH_FIELD_MASS |
+              1ul << SPH_FIELD_DENSITY | 1ul << SPH_FIELD_JACOBIAN |
+              1ul << SPH_FIELD_STRESS | 1ul << SPH_FIELD_PRESSURE |
+              1ul << SPH_FIELD_VON_MISES | 1ul << SPH_FIELD_DISPLACEMENT,
     .setup = ul_sph_setup,
     .stable_dt = ul_sph_stable_dt,
     .step = ul_sph_step,
