@@ -542,6 +542,9 @@ static sph_status parse_bodies(sph_scene *s, sph_node *root, sph_error *err) {
     b->col = n->col;
     const char *name, *mat;
     SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    if (!name[0])
+      return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_RANGE,
+                            "a body needs a name");
     copy_name(b->name, name);
     for (size_t j = 0; j < i; ++j)
       if (!strcmp(s->bodies[j].name, name))
@@ -982,6 +985,13 @@ static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
     return sph_node_error(sph_node_child(out, "every"), err, SPH_ERR_RANGE,
                           "output interval %g is longer than the run (%g)",
                           o->every, s->t_end);
+  /* frame numbers have four digits (<scene>_NNNN.vtp, .png) */
+  double frames = ceil(s->t_end / o->every * (1.0 - 1e-12)) + 1.0;
+  if (frames > 10000.0)
+    return sph_node_error(sph_node_child(out, "every"), err, SPH_ERR_RANGE,
+                          "%.0f output frames (end %g s every %g s); at "
+                          "most 10000: a longer interval, or a shorter run",
+                          frames, s->t_end, o->every);
   sph_node *fields;
   SPH_TRY(sph_node_insert_default(
       out, "fields",
@@ -1028,6 +1038,15 @@ static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
       const char *name;
       SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
       copy_name(p->name, name);
+      if (!name[0])
+        return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_RANGE,
+                              "a probe needs a name");
+      for (size_t j = 0; j < i; ++j)
+        if (!strcmp(o->probes[j].name, p->name))
+          return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_ARG,
+                                "two probes are named '%s' (their columns in "
+                                "probes.csv would clash)",
+                                name);
       SPH_TRY(sph_node_get_doubles(n, "at", 1, (size_t)s->dimension, p->at,
                                    NULL, err));
       sph_node *at = sph_node_child(n, "at");
@@ -1387,6 +1406,14 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
         break;
       double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1);
       initial_velocity(&bd->velocity, xs[b] + 3 * i, vb);
+      if (!isfinite(vb[0] + vb[1] + vb[2])) {
+        char key[48];
+        snprintf(key, sizeof key, "bodies[%zu].initial_velocity", b);
+        st = sph_error_at(err, SPH_ERR_RANGE, s->path, bd->line, bd->col, key,
+                          "not finite at (%g, %g, %g) (body frame)",
+                          xs[b][3 * i], xs[b][3 * i + 1], xs[b][3 * i + 2]);
+        break;
+      }
       if (bd->transform.given)
         rotate(&bd->transform, vb, v);
       else

@@ -211,6 +211,17 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
     }
     stress(r, G, P);
     rw->P_amp = fmax(rw->P_amp, sqrt(sph_mat3_ddot(P, P)));
+    /* an initial state the material can have: finite, not inverted */
+    double J = sph_mat3_det(F);
+    if (!(J > 0.0) || !isfinite(J) || !isfinite(rw->P_amp) ||
+        !isfinite(v[0] + v[1] + v[2]) || !isfinite(u[0] + u[1] + u[2])) {
+      const sph_node *ref = sim->scene->reference;
+      return sph_node_error(
+          ref ? ref : sim->scene->root, err, SPH_ERR_RANGE,
+          "the analytic initial state is %s at particle %zu (J = %g): "
+          "a smaller amplitude",
+          isfinite(J) && isfinite(rw->P_amp) ? "inverted" : "not finite", a, J);
+    }
   }
   sim->initial_defgrad = 1;
   return SPH_OK;

@@ -32,6 +32,13 @@ for f in "$here"/bad/*.yaml; do
   done
 done
 
+# an analytic initial state the material cannot have: refused at check
+for u0 in 1e20 1e308; do
+  "$sph" check "$src/scenes/swinging_cube.yaml" --set reference.U0=$u0 2>"$work/stderr" >/dev/null
+  [ $? -eq 2 ] && grep -q "reference: the analytic initial state is" "$work/stderr" && ok ||
+    bad "reference.U0=$u0: $(cat "$work/stderr")"
+done
+
 # a missing file, a bad --set and usage errors
 "$sph" check "$work/none.yaml" 2>"$work/stderr"
 [ $? -eq 2 ] && grep -qF "$work/none.yaml" "$work/stderr" && ok || bad "missing file"
