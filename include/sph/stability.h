@@ -179,11 +179,12 @@ typedef struct sph_provenance {
 
 /* summary.json (keys documented in the README): `sinks` holds the wall
  * seconds of each of the nsinks sinks; mp4_seconds >= 0 adds the time the
- * mp4 took to assemble. */
+ * mp4 took to assemble; stopped_by names the signal that stopped the run
+ * (NULL: none). */
 sph_status sph_summary_write(const char *path, const sph_sim *sim,
                              const sph_provenance *prov, const sph_verdict *v,
                              double wall_seconds, const sph_sink *sinks,
                              int nsinks, double mp4_seconds, int completed,
-                             sph_error *err);
+                             const char *stopped_by, sph_error *err);
 
 #endif

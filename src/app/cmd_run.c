@@ -5,6 +5,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -167,6 +168,37 @@ static const sph_app_command run_command = {
     "  input or usage, 3 I/O failure\n",
     run_allowed, NULL, NULL};
 
+/* SIGINT, SIGTERM, SIGHUP: the first asks the run to stop at the next step
+ * boundary (outputs finished, a checkpoint, summary.json with stopped_by);
+ * a second one ends the process at once. */
+static volatile sig_atomic_t stop_signal;
+
+static void on_stop_signal(int signo) {
+  if (stop_signal) {
+    signal(signo, SIG_DFL);
+    raise(signo);
+    return;
+  }
+  stop_signal = signo;
+}
+
+static void catch_stop_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  sigaction(SIGHUP, &sa, NULL);
+}
+
+static const char *signal_name(int signo) {
+  return signo == SIGINT    ? "SIGINT"
+         : signo == SIGTERM ? "SIGTERM"
+         : signo == SIGHUP  ? "SIGHUP"
+                            : "a signal";
+}
+
 int sph_cmd_run(int argc, char **argv) {
   sph_app_args args;
   int rc = sph_app_parse_args(argc, argv, &args, &run_command);
@@ -260,6 +292,7 @@ int sph_cmd_run(int argc, char **argv) {
     sinks[i].seconds += sph_wtime() - t0;
   }
 
+  catch_stop_signals();
   sph_progress prog;
   sph_progress_start(&prog, scene->t_end, args.quiet);
   double wall0 = sph_wtime();
@@ -270,7 +303,8 @@ int sph_cmd_run(int argc, char **argv) {
   double eps = 1e-12 * t_end;
   double next_ckpt =
       ckpt > 0.0 ? ckpt * (floor(sim->t / ckpt + 1e-9) + 1.0) : INFINITY;
-  while (st == SPH_OK && verdict->stable && sim->t < t_end - eps) {
+  while (st == SPH_OK && verdict->stable && sim->t < t_end - eps &&
+         !stop_signal) {
     double next = sph_output_time(scene, index);
     st = sph_sim_step(sim, next - sim->t, &err);
     if (st != SPH_OK)
@@ -295,8 +329,20 @@ int sph_cmd_run(int argc, char **argv) {
     }
   }
   sph_progress_finish(&prog);
+  int stopped = stop_signal;
+  if (stopped && st == SPH_OK && sim->t < t_end - eps) {
+    /* stopped between steps: what was written reaches the disk, then a
+     * checkpoint to --resume from */
+    for (int i = 0; i < nsinks && st == SPH_OK; ++i)
+      if (sinks[i].ops->flush)
+        st = sinks[i].ops->flush(&sinks[i], &err);
+    if (st == SPH_OK)
+      st = sph_checkpoint_write(dir, sim, verdict, index, &err);
+  } else {
+    stopped = 0;
+  }
   int failed_step = st != SPH_OK && st != SPH_ERR_IO;
-  if (st == SPH_OK && verdict->stable)
+  if (st == SPH_OK && verdict->stable && !stopped)
     completed = 1;
   if (failed_step && verdict)
     sph_verdict_fail_step(verdict, sim->t, &err);
@@ -332,7 +378,8 @@ int sph_cmd_run(int argc, char **argv) {
     sph_app_provenance(&prov);
     if (sph_summary_write(spath, sim, &prov, verdict, wall, sinks, nsinks,
                           mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
-                          completed, &cerr) != SPH_OK) {
+                          completed, stopped ? signal_name(stopped) : NULL,
+                          &cerr) != SPH_OK) {
       io_failed = 1;
       err = cerr;
     }
@@ -340,6 +387,11 @@ int sph_cmd_run(int argc, char **argv) {
   if (io_failed) {
     sph_app_print_error(&err);
     rc = sph_app_exit_code(err.code);
+  } else if (stopped) {
+    printf("stopped by %s at t = %.6g s (%lu steps, %.2f s wall): outputs "
+           "and a checkpoint written; continue with --resume %s\n",
+           signal_name(stopped), sim->t, sim->steps, wall, dir);
+    rc = 128 + stopped;
   } else if (verdict && !verdict->stable) {
     printf("verdict: UNSTABLE - %s tripped at t = %.6g s: %s (%lu steps, "
            "%.2f s wall)\n",

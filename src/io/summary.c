@@ -32,7 +32,7 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
                              const sph_provenance *prov, const sph_verdict *v,
                              double wall_seconds, const sph_sink *sinks,
                              int nsinks, double mp4_seconds, int completed,
-                             sph_error *err) {
+                             const char *stopped_by, sph_error *err) {
   sph_atomic_file af;
   sph_status st = sph_atomic_open(&af, path, err);
   if (st != SPH_OK)
@@ -174,7 +174,13 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_number(f, sim->scene->t_end);
   fputs(",\n  \"t_reached\": ", f);
   json_number(f, sim->t);
-  fprintf(f, ",\n  \"completed\": %s\n}\n", completed ? "true" : "false");
+  fprintf(f, ",\n  \"completed\": %s", completed ? "true" : "false");
+  fputs(",\n  \"stopped_by\": ", f);
+  if (stopped_by)
+    fprintf(f, "\"%s\"", stopped_by);
+  else
+    fputs("null", f);
+  fputs("\n}\n", f);
   st = sph_atomic_commit(&af, err);
   if (st != SPH_OK)
     sph_atomic_abort(&af);
