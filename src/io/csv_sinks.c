@@ -50,10 +50,17 @@ static sph_status energy_open(sph_sink *sink, const sph_sim *sim,
   sink->data = af;
   int fresh;
   sph_status st = csv_open(sink, af, dir, "energy.csv", &fresh, err);
+  /* units in the header; plane-strain (2D) runs count per metre of depth */
+  int d2 = sim->scene->dimension == 2;
+  const char *e = d2 ? "J/m" : "J", *p = d2 ? "kg/s" : "kg m/s",
+             *l = d2 ? "kg m/s" : "kg m^2/s";
   if (st == SPH_OK && fresh)
-    fprintf(af->f, "time,kinetic,strain,total,linear_momentum_x,"
-                   "linear_momentum_y,linear_momentum_z,angular_momentum_x,"
-                   "angular_momentum_y,angular_momentum_z\n");
+    fprintf(af->f,
+            "time [s],kinetic [%s],strain [%s],total [%s],"
+            "linear_momentum_x [%s],linear_momentum_y [%s],"
+            "linear_momentum_z [%s],angular_momentum_x [%s],"
+            "angular_momentum_y [%s],angular_momentum_z [%s]\n",
+            e, e, e, p, p, p, l, l, l);
   return st;
 }
 
@@ -119,15 +126,16 @@ static sph_status probe_open(sph_sink *sink, const sph_sim *sim,
   static const char *const comp3[] = {"_x", "_y", "_z"};
   static const char *const comp9[] = {"_xx", "_xy", "_xz", "_yx", "_yy",
                                       "_yz", "_zx", "_zy", "_zz"};
-  fprintf(p->af.f, "time");
+  fprintf(p->af.f, "time [s]");
   for (size_t k = 0; k < s->output.nprobes; ++k) {
     const sph_probe *pr = &s->output.probes[k];
     for (int f = 0; f < pr->nfields; ++f) {
       int nc = sph_field_components((sph_field)pr->fields[f]);
       for (int c = 0; c < nc; ++c)
-        fprintf(p->af.f, ",%s.%s%s", pr->name,
+        fprintf(p->af.f, ",%s.%s%s [%s]", pr->name,
                 sph_field_name((sph_field)pr->fields[f]),
-                nc == 1 ? "" : (nc == 3 ? comp3[c] : comp9[c]));
+                nc == 1 ? "" : (nc == 3 ? comp3[c] : comp9[c]),
+                sph_field_unit((sph_field)pr->fields[f]));
     }
   }
   fputc('\n', p->af.f);

@@ -132,14 +132,15 @@ def main():
                 break
         # the probe particle: nearest to the probe in the reference state
         row = probes[k]
-        if not close(float(row["time"]), tb[k], 1e-12):
-            fail("probe time %s vs frame time %s" % (row["time"], tb[k]))
+        if not close(float(row["time [s]"]), tb[k], 1e-12):
+            fail("probe time %s vs frame time %s" % (row["time [s]"], tb[k]))
         at = (0.5, 6.0, 0.5)
         i = min(range(n), key=lambda j: sum((X[j][c] - at[c]) ** 2
                                             for c in range(3)))
         for c, s in enumerate("xyz"):
             for field in ("displacement", "velocity"):
-                want = float(row["tip.%s_%s" % (field, s)])
+                unit = "m" if field == "displacement" else "m/s"
+                want = float(row["tip.%s_%s [%s]" % (field, s, unit)])
                 if not close(b[field][1][i][c], want, 1e-12):
                     fail("%s: tip %s_%s %r vs probes.csv %r" %
                          (path_b, field, s, b[field][1][i][c], want))

@@ -114,7 +114,8 @@ START_TEST(run_outputs_read_back) {
   int rows = 0;
   double t, k, w, tot, px;
   ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
-  ck_assert_ptr_nonnull(strstr(line, "time,kinetic,strain,total"));
+  ck_assert_ptr_nonnull(
+      strstr(line, "time [s],kinetic [J],strain [J],total [J]"));
   while (fgets(line, sizeof line, f)) {
     ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &t, &k, &w, &tot, &px),
                      5);
