@@ -4,11 +4,13 @@
  * validated. */
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -199,6 +201,35 @@ static const char *signal_name(int signo) {
                             : "a signal";
 }
 
+/* One run per output folder: an exclusive lock on DIR/.sph.lock, held until
+ * the process ends, with the holder's pid in the file. Returns the open
+ * descriptor, or -1 with *holder the running pid (0: the lock file could
+ * not be made). */
+static int lock_output(const char *dir, long *holder) {
+  char path[1100];
+  snprintf(path, sizeof path, "%s/.sph.lock", dir);
+  *holder = 0;
+  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return -1;
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    char buf[32] = "";
+    ssize_t k = pread(fd, buf, sizeof buf - 1, 0);
+    buf[k > 0 ? k : 0] = '\0';
+    *holder = strtol(buf, NULL, 10);
+    *holder = *holder > 0 ? *holder : 1;
+    close(fd);
+    return -1;
+  }
+  char pid[32];
+  int len = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, (size_t)len, 0) != len) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
 int sph_cmd_run(int argc, char **argv) {
   sph_app_args args;
   int rc = sph_app_parse_args(argc, argv, &args, &run_command);
@@ -245,6 +276,21 @@ int sph_cmd_run(int argc, char **argv) {
     sph_sim_destroy(sim);
     sph_scene_destroy(scene);
     return SPH_EXIT_IO;
+  }
+  long holder;
+  int lock_fd = lock_output(dir, &holder);
+  if (lock_fd < 0) {
+    if (holder > 0)
+      fprintf(stderr,
+              "sph: %s is in use by another sph run (pid %ld); wait for it "
+              "or write elsewhere with --out DIR\n",
+              dir, holder);
+    else
+      fprintf(stderr, "sph: cannot lock the output folder %s: %s\n", dir,
+              strerror(errno));
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return holder > 0 ? SPH_EXIT_USAGE : SPH_EXIT_IO;
   }
   if (args.overwrite && !args.resume)
     remove_previous(dir, scene->name);
@@ -419,5 +465,6 @@ int sph_cmd_run(int argc, char **argv) {
   sph_verdict_destroy(verdict);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
+  close(lock_fd); /* the folder is free for the next run */
   return rc;
 }

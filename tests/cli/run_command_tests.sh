@@ -100,5 +100,25 @@ rc=$?
 [ $? -eq 2 ] && grep -qF "output.png: expected a mapping, true or false" "$work/stderr" && ok ||
   bad "output.png=maybe: $(cat "$work/stderr")"
 
+# one run per output folder: a second run into a busy folder is refused
+# naming the running one's pid (issue 21 item 6)
+"$sph" run "$src/scenes/twisting_column.yaml" --out "$work/busy" --quiet --threads 1 \
+  --set time.end=30 --set output.png=false >/dev/null 2>&1 &
+first=$!
+for _ in $(seq 200); do
+  [ -s "$work/busy/.sph.lock" ] && [ -f "$work/busy/scene_used.yaml" ] && break
+  sleep 0.02
+done
+"$sph" run "$src/scenes/twisting_column.yaml" --out "$work/busy" --quiet --overwrite \
+  --set time.end=0.01 >/dev/null 2>"$work/stderr"
+rc=$?
+kill -TERM $first
+wait $first
+[ $rc -eq 2 ] && grep -qF "$work/busy is in use by another sph run (pid $first)" "$work/stderr" &&
+  [ -f "$work/busy/scene_used.yaml" ] && ok || bad "busy folder: exit $rc: $(cat "$work/stderr")"
+"$sph" run "$src/scenes/twisting_column.yaml" --out "$work/busy" --quiet --overwrite \
+  --set 'bodies.0.particles.count=[3,7,3]' --set time.end=0.01 --set output.png=false >/dev/null 2>&1 &&
+  ok || bad "the folder is not free after the first run ended"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
