@@ -332,6 +332,7 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
   ul_sph *m = sim->method_data;
   long n = (long)m->n;
   double *accs = m->acc + 3 * m->n;
+  double t0 = sph_wtime(), ti; /* the integration's own loops, timed */
   /* eq. 27: half a step of position and density, pressure from eq. 4 */
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
@@ -340,10 +341,12 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
       m->x[3 * a + c] += 0.5 * dt * m->v[3 * a + c];
     m->p[a] = m->c0[a] * m->c0[a] * (m->rho[a] - m->rho0[a]);
   }
+  ti = sph_wtime() - t0;
   accelerations(m, m->acc, accs);
   sph_stage st = {.t = sim->t + 0.5 * dt, .x = m->x, .p = m->v, .dp = m->acc};
   SPH_TRY(sph_sim_terms_rates(sim, &st, err));
   /* eq. 28, and the work done against the shear force */
+  t0 = sph_wtime();
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double w = 0.0;
@@ -354,24 +357,37 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
     }
     m->work[a] -= dt * m->m[a] * w;
   }
+  ti += sph_wtime() - t0;
   sph_stage cs = {.t = sim->t + dt, .x = m->x, .p = m->v};
   SPH_TRY(sph_sim_terms_constrain(sim, &cs, err));
   /* eq. 29 */
+  t0 = sph_wtime();
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
       m->x[3 * a + c] += 0.5 * dt * m->v[3 * a + c];
+  ti += sph_wtime() - t0;
   continuity_and_shear(m, dt);
+  t0 = sph_wtime();
+  long bad = n; /* the first particle with a non-finite or non-positive state */
+#pragma omp parallel for schedule(static) reduction(min : bad)
   for (long a = 0; a < n; ++a) {
     m->rho[a] += 0.5 * dt * m->drho[a];
-    if (!isfinite(m->rho[a]) || !isfinite(m->v[3 * a]) ||
+    if (!(m->rho[a] > 0.0) || !isfinite(m->rho[a]) || !isfinite(m->v[3 * a]) ||
         !isfinite(m->v[3 * a + 1]) || !isfinite(m->v[3 * a + 2]))
-      return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "particle %ld: non-finite state", a);
-    if (!(m->rho[a] > 0.0))
-      return sph_error_set(err, SPH_ERR_NUMERIC, "particle %ld: density %g", a,
-                           m->rho[a]);
+      bad = a < bad ? a : bad;
   }
+  if (bad < n)
+    return sph_error_set(err, SPH_ERR_NUMERIC,
+                         isfinite(m->rho[bad]) && isfinite(m->v[3 * bad]) &&
+                                 isfinite(m->v[3 * bad + 1]) &&
+                                 isfinite(m->v[3 * bad + 2])
+                             ? "particle %ld: density %g"
+                             : "particle %ld: non-finite state (density %g)",
+                         bad, m->rho[bad]);
+  sph_timer *tm = &sim->timers[m->timer_integration];
+  tm->seconds += ti + sph_wtime() - t0;
+  tm->calls++;
   double t1 = sim->t + dt;
   /* (an output time may leave a sliver of the advection step: skip it) */
   if (!m->dual || t1 >= m->config[0] - 0.1 * dt)
@@ -658,6 +674,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->timer_config = sph_sim_add_timer(sim, "configuration");
   m->timer_pressure = sph_sim_add_timer(sim, "pressure_and_shear_force");
   m->timer_shear = sph_sim_add_timer(sim, "continuity_and_shear_rate");
+  m->timer_integration = sph_sim_add_timer(sim, "time_integration");
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, NULL, err));
   if (sph_scene_has_essential_bc(s)) {

@@ -50,6 +50,7 @@ typedef struct ul_sph {
   double config[2]; /* time of the next configuration update, updates */
   double *xcfg;     /* positions at the last update (3) */
   int timer_config, timer_pressure, timer_shear;
+  int timer_integration; /* position Verlet's own loops, the finite check */
 } ul_sph;
 
 #endif
