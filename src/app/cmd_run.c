@@ -31,49 +31,82 @@ static int file_exists(const char *dir, const char *name) {
   return stat(path, &st) == 0;
 }
 
-/* Removes only the files an earlier run of ours wrote. */
-static void remove_previous(const char *dir, const char *scene) {
-  static const char *const names[] = {
-      "summary.json",    "energy.csv",        "probes.csv",
-      "scene_used.yaml", SPH_CHECKPOINT_FILE, SPH_CHECKPOINT_PREVIOUS,
-      "energy.csv.part", "probes.csv.part",   NULL};
-  char path[1200];
-  for (const char *const *n = names; *n; ++n) {
-    snprintf(path, sizeof path, "%s/%s", dir, *n);
-    remove(path);
+/* name is <scene>_NNNN<suffix> (four digits) or <scene><suffix> with
+ * numbered = 0 */
+static int run_file(const char *name, const char *scene, const char *suffix,
+                    int numbered) {
+  size_t p = strlen(scene);
+  if (strncmp(name, scene, p))
+    return 0;
+  const char *rest = name + p;
+  if (numbered) {
+    if (rest[0] != '_' || strspn(rest + 1, "0123456789") != 4)
+      return 0;
+    rest += 5;
   }
-  DIR *d = opendir(dir);
-  struct dirent *e;
-  while (d && (e = readdir(d))) {
-    size_t len = strlen(e->d_name);
-    if ((len > 4 && !strcmp(e->d_name + len - 4, ".vtp")) ||
-        (len > 4 && !strcmp(e->d_name + len - 4, ".pvd"))) {
-      snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+  return !strcmp(rest, suffix);
+}
+
+/* Removes the files in dir that the run named `scene` writes, and its
+ * temporary (.part) ones. */
+static void remove_run_files(const char *dir, const char *scene) {
+  static const char *const names[] = {"summary.json",
+                                      "energy.csv",
+                                      "probes.csv",
+                                      "scene_used.yaml",
+                                      SPH_CHECKPOINT_FILE,
+                                      SPH_CHECKPOINT_PREVIOUS,
+                                      NULL};
+  static const char *const numbered[] = {".vtp", ".vtp.part", ".png",
+                                         ".png.part", NULL};
+  static const char *const single[] = {".pvd", ".pvd.part", ".mp4", ".mp4.part",
+                                       NULL};
+  char path[2400];
+  for (const char *const *n = names; *n; ++n)
+    for (int part = 0; part < 2; ++part) {
+      snprintf(path, sizeof path, "%s/%s%s", dir, *n, part ? ".part" : "");
       remove(path);
     }
-  }
-  if (d)
-    closedir(d);
-  /* the animation and frames/<scene>_NNNN.png */
-  snprintf(path, sizeof path, "%s/%s.mp4", dir, scene);
-  remove(path);
-  snprintf(path, sizeof path, "%s/%s.mp4.part", dir, scene);
-  remove(path);
-  char frames[1100], fpath[1400];
-  snprintf(frames, sizeof frames, "%s/frames", dir);
-  size_t prefix = strlen(scene);
-  d = opendir(frames);
-  while (d && (e = readdir(d))) {
-    const char *rest = e->d_name + prefix;
-    if (!strncmp(e->d_name, scene, prefix) && rest[0] == '_' &&
-        strspn(rest + 1, "0123456789") == 4 &&
-        (!strcmp(rest + 5, ".png") || !strcmp(rest + 5, ".png.part"))) {
-      snprintf(fpath, sizeof fpath, "%s/%s", frames, e->d_name);
-      remove(fpath);
+  char sub[2][1100];
+  snprintf(sub[0], sizeof sub[0], "%s", dir);
+  snprintf(sub[1], sizeof sub[1], "%s/frames", dir);
+  for (int k = 0; k < 2; ++k) {
+    DIR *d = opendir(sub[k]);
+    struct dirent *e;
+    while (d && (e = readdir(d))) {
+      int ours = 0;
+      for (const char *const *x = numbered; *x && !ours; ++x)
+        ours = run_file(e->d_name, scene, *x, 1);
+      for (const char *const *x = single; *x && !ours && k == 0; ++x)
+        ours = run_file(e->d_name, scene, *x, 0);
+      if (!ours)
+        continue;
+      snprintf(path, sizeof path, "%s/%s", sub[k], e->d_name);
+      remove(path);
     }
+    if (d)
+      closedir(d);
   }
-  if (d)
-    closedir(d);
+}
+
+/* --overwrite: removes only the files an earlier run of ours wrote, named
+ * after the scene its scene_used.yaml records (and this run's), never
+ * other files of the folder. */
+static void remove_previous(const char *dir, const char *scene) {
+  char path[1200], line[256], previous[256] = "";
+  snprintf(path, sizeof path, "%s/scene_used.yaml", dir);
+  FILE *f = fopen(path, "r");
+  while (f && fgets(line, sizeof line, f))
+    if (!strncmp(line, "name: ", 6)) {
+      line[strcspn(line, "\r\n")] = '\0';
+      snprintf(previous, sizeof previous, "%s", line + 6);
+      break;
+    }
+  if (f)
+    fclose(f);
+  if (previous[0] && strcmp(previous, scene) && !strchr(previous, '/'))
+    remove_run_files(dir, previous);
+  remove_run_files(dir, scene);
 }
 
 static void banner(const sph_sim *sim, const char *dir) {

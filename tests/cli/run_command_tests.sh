@@ -120,5 +120,21 @@ wait $first
   --set 'bodies.0.particles.count=[3,7,3]' --set time.end=0.01 --set output.png=false >/dev/null 2>&1 &&
   ok || bad "the folder is not free after the first run ended"
 
+# --overwrite removes what the earlier run wrote, never the user's files
+# (issue 21 item 3)
+ow=$work/ow
+"$sph" run "$tiny" --out "$ow" --quiet --set output.png=true >/dev/null 2>&1
+mkdir -p "$ow/frames"
+touch "$ow/notes.vtp" "$ow/mesh.pvd" "$ow/other_0001.vtp" "$ow/frames/photo.png" \
+  "$ow/twisting_column_0099.vtp.part"
+"$sph" run "$tiny" --out "$ow" --quiet --overwrite --set 'output.fields=[pressure]' \
+  --set time.end=0.01 >/dev/null 2>&1
+if [ -f "$ow/notes.vtp" ] && [ -f "$ow/mesh.pvd" ] && [ -f "$ow/other_0001.vtp" ] &&
+  [ -f "$ow/frames/photo.png" ] && [ ! -e "$ow/twisting_column_0099.vtp.part" ] &&
+  [ ! -e "$ow/twisting_column_0004.vtp" ] && [ ! -e "$ow/frames/twisting_column_0004.png" ] &&
+  [ -f "$ow/twisting_column_0002.vtp" ]; then ok; else
+  bad "--overwrite: $(ls "$ow" "$ow/frames")"
+fi
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
