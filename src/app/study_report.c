@@ -216,6 +216,44 @@ static int same_series(const study *s, const study_case *a,
   return 1;
 }
 
+/* The short name of a varied key: its last component ("method.fields" ->
+ * "fields"), or its last two when another key ends the same way. */
+static const char *key_short(const study *s, int k, char *buf, size_t len) {
+  const char *key = s->keys[k], *dot = strrchr(key, '.');
+  const char *last = dot ? dot + 1 : key;
+  for (int j = 0; j < s->nkeys; ++j) {
+    const char *o = strrchr(s->keys[j], '.');
+    if (j != k && !strcmp(o ? o + 1 : s->keys[j], last) && dot) {
+      const char *prev = dot;
+      while (prev > key && prev[-1] != '.')
+        --prev;
+      snprintf(buf, len, "%s", prev);
+      return buf;
+    }
+  }
+  snprintf(buf, len, "%s", last);
+  return buf;
+}
+
+/* A value as a legend shows it: YAML braces and quotes dropped, spaces
+ * after ':' and ',' kept single ("{name: tl-csph}" -> "name: tl-csph"). */
+static void value_short(const char *v, char *buf, size_t len) {
+  size_t n = 0;
+  for (; *v && n + 1 < len; ++v)
+    if (*v != '{' && *v != '}' && *v != '"' && *v != '\'')
+      buf[n++] = *v;
+  buf[n] = '\0';
+}
+
+/* Whether key k takes more than one value among the series leads. */
+static int key_varies(const study *s, int k, const int *leads, int nlead) {
+  for (int j = 1; j < nlead; ++j)
+    if (strcmp(s->cases[leads[j]].values[k], s->cases[leads[0]].values[k]))
+      return 1;
+  return 0;
+}
+
+/* report.md: every key but the resolution one, in full */
 static void series_label(const study *s, const study_case *c, char *buf,
                          size_t len) {
   buf[0] = '\0';
@@ -228,6 +266,24 @@ static void series_label(const study *s, const study_case *c, char *buf,
   }
   if (!buf[0])
     snprintf(buf, len, "all");
+}
+
+/* a plot's legend: the short names and values of the keys that differ
+ * between the series */
+static void series_legend(const study *s, const study_case *c, const int *leads,
+                          int nlead, char *buf, size_t len) {
+  buf[0] = '\0';
+  for (int k = 0; k < s->nkeys; ++k) {
+    if (k == s->resolution || !key_varies(s, k, leads, nlead))
+      continue;
+    char name[128], value[256];
+    size_t used = strlen(buf);
+    value_short(c->values[k], value, sizeof value);
+    snprintf(buf + used, len - used, "%s%s %s", used ? ", " : "",
+             key_short(s, k, name, sizeof name), value);
+  }
+  if (!buf[0])
+    snprintf(buf, len, "%s", s->scene_name);
 }
 
 /* Which norms any finished run reports. */
@@ -483,12 +539,12 @@ static void gp_figure(FILE *f, const study *s, const int *leads, int nlead,
     if (!present[k])
       continue;
     fprintf(f, "set ylabel '%s'\nplot ", study_norm_names[k]);
-    int first = 1;
+    int first = 1, labelled = 0;
     for (int j = 0; j < nlead; ++j) {
       if (!series_points(s, leads[j], k, xdp))
         continue;
       char label[2048];
-      series_label(s, &s->cases[leads[j]], label, sizeof label);
+      series_legend(s, &s->cases[leads[j]], leads, nlead, label, sizeof label);
       if (strlen(label) > 60) /* legends stay readable; report.md has all */
         strcpy(label + 57, "...");
       double order = NAN, c0 = NAN;
@@ -501,14 +557,24 @@ static void gp_figure(FILE *f, const study *s, const int *leads, int nlead,
       fprintf(f, "%s$s%d_%d_%d using 1:2 with linespoints lc %d pt 7 title ",
               first ? "" : ", \\\n  ", j, k, xdp, j + 1);
       gp_string(f, label);
-      fprintf(f,
-              ", $s%d_%d_%d using 1:2:3 with labels offset 0.8,0.8 "
-              "font ',7' notitle",
-              j, k, xdp);
-      if (xdp && isfinite(order))
-        fprintf(f, ", exp(%.9g)*x**%.9g with lines dt 2 lc %d notitle", c0,
-                order, j + 1);
+      /* the resolution labels once: the series share their x values */
+      if (!labelled)
+        fprintf(f,
+                ", $s%d_%d_%d using 1:2:3 with labels offset 0.8,0.8 "
+                "font ',7' notitle",
+                j, k, xdp);
+      labelled = 1;
       first = 0;
+    }
+    /* the fits last, drawn over the data */
+    for (int j = 0; xdp && j < nlead; ++j) {
+      double order = NAN, c0 = NAN;
+      if (!series_points(s, leads[j], k, xdp))
+        continue;
+      series_fit(s, leads[j], k, &order, &c0);
+      if (isfinite(order))
+        fprintf(f, ", exp(%.9g)*x**%.9g with lines dt 2 lw 1.5 lc %d notitle",
+                c0, order, j + 1);
     }
     fputc('\n', f);
   }
