@@ -149,8 +149,7 @@ double sph_png_field_centre(int field) {
                                        : NAN;
 }
 
-/* Scalar value of particle a: the field itself or its magnitude. */
-static double particle_value(const double *f, int nc, size_t a) {
+double sph_png_value(const double *f, int nc, size_t a) {
   if (nc == 1)
     return f[a];
   double s = 0.0;
@@ -161,6 +160,19 @@ static double particle_value(const double *f, int nc, size_t a) {
 
 static double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* r = f x up, normalised; 0 when they are parallel */
+static int right_of(const double f[3], const double up[3], double r[3]) {
+  r[0] = f[1] * up[2] - f[2] * up[1];
+  r[1] = f[2] * up[0] - f[0] * up[2];
+  r[2] = f[0] * up[1] - f[1] * up[0];
+  double rl = sqrt(dot3(r, r));
+  if (!(rl > 0.0))
+    return 0;
+  for (int k = 0; k < 3; ++k)
+    r[k] /= rl;
+  return 1;
 }
 
 /* Share of the frame kept free of particles for the colour bar (right) and
@@ -201,15 +213,11 @@ static void png_fit(const sph_scene *s, const double lo[3], const double hi[3],
     wpp = 2.0 * dist * t / H;
   }
   /* move the camera right and up: the box to the left and down */
-  r[0] = f[1] * v->up[2] - f[2] * v->up[1];
-  r[1] = f[2] * v->up[0] - f[0] * v->up[2];
-  r[2] = f[0] * v->up[1] - f[1] * v->up[0];
-  double rl = sqrt(dot3(r, r));
-  if (!(rl > 0.0))
+  if (!right_of(f, v->up, r))
     return;
   double right = 0.5 * (W - we) * wpp, up = 0.5 * (H - he) * wpp;
   for (int k = 0; k < 3; ++k) {
-    double d = right * r[k] / rl + up * v->up[k];
+    double d = right * r[k] + up * v->up[k];
     v->eye[k] += d;
     v->target[k] += d;
   }
@@ -261,14 +269,8 @@ static void png_view(const sph_sim *sim, sph_view *v, double lo[3],
     return;
   for (int k = 0; k < 3; ++k)
     f[k] /= fl;
-  r[0] = f[1] * v->up[2] - f[2] * v->up[1];
-  r[1] = f[2] * v->up[0] - f[0] * v->up[2];
-  r[2] = f[0] * v->up[1] - f[1] * v->up[0];
-  double rl = sqrt(dot3(r, r));
-  if (!(rl > 0.0))
+  if (!right_of(f, v->up, r))
     return;
-  for (int k = 0; k < 3; ++k)
-    r[k] /= rl;
   u[0] = r[1] * f[2] - r[2] * f[1];
   u[1] = r[2] * f[0] - r[0] * f[2];
   u[2] = r[0] * f[1] - r[1] * f[0];
@@ -739,7 +741,7 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
   size_t nf = 0;
   for (size_t j = 0; j < n; ++j) { /* creation order, as the VTK files */
     size_t a = sph_particles_slot(fr->ps, j);
-    double v = field ? particle_value(field, nc, a) : NAN;
+    double v = field ? sph_png_value(field, nc, a) : NAN;
     if (isfinite(v)) {
       vmin = fmin(vmin, v);
       vmax = fmax(vmax, v);

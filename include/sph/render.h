@@ -33,6 +33,10 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err);
  * 1 for J; NaN for the fields drawn one-sided (viridis). */
 double sph_png_field_centre(int field);
 
+/* The value a frame colours particle a by: field f of nc components
+ * itself (nc 1) or its magnitude. */
+double sph_png_value(const double *f, int nc, size_t a);
+
 /* What sph_mp4_assemble did. */
 typedef struct sph_mp4_info {
   char path[1100]; /* <dir>/<scene>.mp4 */

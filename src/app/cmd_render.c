@@ -128,16 +128,6 @@ static int add_overrides(render_args *a, char buf[4][96], int png_on) {
   return 0;
 }
 
-/* The value the frame colours by: the field or its magnitude. */
-static double value_of(const double *v, int nc, size_t a) {
-  if (nc == 1)
-    return v[a];
-  double s = 0.0;
-  for (int c = 0; c < nc; ++c)
-    s += v[(size_t)nc * a + c] * v[(size_t)nc * a + c];
-  return sqrt(s);
-}
-
 typedef struct render_job {
   sph_scene *scene;
   sph_particles *ps;
@@ -167,7 +157,7 @@ static sph_status global_range(render_job *j, int field, sph_error *err) {
                          sph_field_name((sph_field)field), nc, ps->field[field],
                          &t, err));
     for (size_t a = 0; a < ps->n; ++a) {
-      double v = value_of(ps->field[field], nc, a);
+      double v = sph_png_value(ps->field[field], nc, a);
       if (!isfinite(v))
         continue;
       lo = fmin(lo, v);

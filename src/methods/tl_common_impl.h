@@ -16,6 +16,16 @@
 #include "sph/sim.h"
 #include "sph/tensor.h"
 
+/* The output fields the total-Lagrangian methods fill (sph_method_ops). */
+#define TL_OUTPUT_FIELDS                                                       \
+  (1ul << SPH_FIELD_POSITION0 | 1ul << SPH_FIELD_POSITION |                    \
+   1ul << SPH_FIELD_VELOCITY | 1ul << SPH_FIELD_ACCELERATION |                 \
+   1ul << SPH_FIELD_VOLUME0 | 1ul << SPH_FIELD_MASS |                          \
+   1ul << SPH_FIELD_DEFGRAD | 1ul << SPH_FIELD_JACOBIAN |                      \
+   1ul << SPH_FIELD_PK1 | 1ul << SPH_FIELD_STRESS |                            \
+   1ul << SPH_FIELD_PRESSURE | 1ul << SPH_FIELD_VON_MISES |                    \
+   1ul << SPH_FIELD_DISPLACEMENT)
+
 typedef struct tl_reference {
   size_t n, n_ext;          /* real particles, real + mirror images */
   double *X;                /* reference positions (3 n_ext) */

@@ -173,13 +173,7 @@ const sph_method_ops tl_csph_method_ops = {
     .title = "Total-Lagrangian corrected SPH, displacement-based (baseline)",
     .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 2, eq. 8-11",
     .conserves_angular_momentum = 1,
-    .fields = 1ul << SPH_FIELD_POSITION0 | 1ul << SPH_FIELD_POSITION |
-              1ul << SPH_FIELD_VELOCITY | 1ul << SPH_FIELD_ACCELERATION |
-              1ul << SPH_FIELD_VOLUME0 | 1ul << SPH_FIELD_MASS |
-              1ul << SPH_FIELD_DEFGRAD | 1ul << SPH_FIELD_JACOBIAN |
-              1ul << SPH_FIELD_PK1 | 1ul << SPH_FIELD_STRESS |
-              1ul << SPH_FIELD_PRESSURE | 1ul << SPH_FIELD_VON_MISES |
-              1ul << SPH_FIELD_DISPLACEMENT,
+    .fields = TL_OUTPUT_FIELDS,
     .setup = tl_csph_setup,
     .stable_dt = tl_csph_stable_dt,
     .step = tl_csph_step,

@@ -479,13 +479,7 @@ const sph_method_ops tl_jst_method_ops = {
     .reference = "seed 000 (Lee et al. 2016) sec. 3-7, Algorithm 1; seed 003 "
                  "eq. 11",
     .conserves_angular_momentum = 1,
-    .fields = 1ul << SPH_FIELD_POSITION0 | 1ul << SPH_FIELD_POSITION |
-              1ul << SPH_FIELD_VELOCITY | 1ul << SPH_FIELD_ACCELERATION |
-              1ul << SPH_FIELD_VOLUME0 | 1ul << SPH_FIELD_MASS |
-              1ul << SPH_FIELD_DEFGRAD | 1ul << SPH_FIELD_JACOBIAN |
-              1ul << SPH_FIELD_PK1 | 1ul << SPH_FIELD_STRESS |
-              1ul << SPH_FIELD_PRESSURE | 1ul << SPH_FIELD_VON_MISES |
-              1ul << SPH_FIELD_DISPLACEMENT,
+    .fields = TL_OUTPUT_FIELDS,
     .setup = tl_jst_setup,
     .stable_dt = tl_jst_stable_dt,
     .step = tl_jst_step,
