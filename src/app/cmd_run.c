@@ -284,6 +284,16 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
+  const char *given = args.resume ? args.resume : args.out;
+  if (given && strlen(given) > 900) { /* room for the files' own names */
+    fprintf(stderr,
+            "sph: the output folder's path is %zu bytes long; at "
+            "most 900\n",
+            strlen(given));
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
   if (args.resume)
     snprintf(dir, sizeof dir, "%s", args.resume);
   else if (args.out)

@@ -2,6 +2,7 @@
  * SPH. Dispatches to the sub-commands (DESIGN.md sec. 1). */
 #include <errno.h>
 #include <omp.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -243,6 +244,9 @@ static void short_spin_wait_policy(char **argv) {
 }
 
 int main(int argc, char **argv) {
+  /* past a file-size limit a write fails with EFBIG, reported like a full
+   * disk, instead of the process being killed mid-file */
+  signal(SIGXFSZ, SIG_IGN);
   short_spin_wait_policy(argv);
   remember_command_line(argc, argv);
   if (argc < 2) {

@@ -5,6 +5,8 @@
  * YAML writer on libyaml's emitter; Levenshtein "did you mean" hints. */
 #include "sph/node.h"
 
+#define SPH_SCENE_MAX_BYTES (1 << 20)
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -299,9 +301,43 @@ static sph_status parse_error(const yaml_parser_t *p, const char *text,
 
 /* Parses one YAML document from text; an empty one is an error unless
  * allow_empty, which gives an empty scalar. */
+/* Flow collections ([ ], { }) nested deeper than MAX_DEPTH, found before
+ * the YAML parser, whose time grows with the square of such nesting (80 kB
+ * of brackets took 1.9 s): SPH_OK or the error at the first one too deep. */
+static sph_status flow_depth(const char *text, size_t len, const char *origin,
+                             sph_error *err) {
+  int depth = 0, line = 1, col = 0;
+  char quote = 0;
+  for (size_t i = 0; i < len; ++i) {
+    char c = text[i];
+    ++col;
+    if (c == '\n') {
+      line++, col = 0;
+      continue;
+    }
+    if (quote) {
+      quote = c == quote ? 0 : quote;
+      continue;
+    }
+    if (c == '"' || c == '\'')
+      quote = c;
+    else if (c == '#' && (i == 0 || text[i - 1] == ' ' || col == 1))
+      while (i + 1 < len && text[i + 1] != '\n')
+        ++i;
+    else if (c == '[' || c == '{') {
+      if (++depth > MAX_DEPTH)
+        return sph_error_at(err, SPH_ERR_RANGE, origin, line, col, NULL,
+                            "nesting deeper than %d levels", MAX_DEPTH);
+    } else if ((c == ']' || c == '}') && depth > 0)
+      depth--;
+  }
+  return SPH_OK;
+}
+
 static sph_status load_text(const char *text, size_t len, const char *origin,
                             int allow_empty, sph_node **root, sph_error *err) {
   *root = NULL;
+  SPH_TRY(flow_depth(text, len, origin, err));
   yaml_parser_t parser;
   if (!yaml_parser_initialize(&parser))
     return sph_error_set(err, SPH_ERR_NOMEM, "YAML parser");
@@ -359,13 +395,22 @@ sph_status sph_node_load_file(sph_node **root, const char *path,
   if (!f)
     return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
                         "cannot open the scene file: %s", strerror(errno));
-  /* read it whole: reader errors are reported by offset into the text */
+  /* read it whole: reader errors are reported by offset into the text; a
+   * scene is a few kB, so anything beyond SPH_SCENE_MAX_BYTES (a device, a
+   * mistaken file) is refused before it fills the memory */
   size_t len = 0, cap = 4096;
   char *text = malloc(cap);
   while (text) {
     len += fread(text + len, 1, cap - len, f);
     if (len < cap)
       break;
+    if (len > SPH_SCENE_MAX_BYTES) {
+      free(text);
+      fclose(f);
+      return sph_error_at(err, SPH_ERR_RANGE, path, 0, 0, NULL,
+                          "not a scene: more than %d bytes",
+                          SPH_SCENE_MAX_BYTES);
+    }
     char *t = realloc(text, cap *= 2);
     if (!t)
       free(text);

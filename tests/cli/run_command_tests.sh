@@ -136,5 +136,22 @@ if [ -f "$ow/notes.vtp" ] && [ -f "$ow/mesh.pvd" ] && [ -f "$ow/other_0001.vtp" 
   bad "--overwrite: $(ls "$ow" "$ow/frames")"
 fi
 
+# a path too long for the run's files: refused before anything is written
+long=$work/$(printf 'd%.0s' $(seq 950))
+"$sph" run "$tiny" --out "$long" --quiet 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "at most 900" "$work/stderr" && [ ! -e "$long" ] && ok ||
+  bad "long --out: $(cat "$work/stderr")"
+# past a file-size limit (no trap of SIGXFSZ here): a clean I/O error,
+# exit 3, no temporary file left (issue 21 item 5)
+(
+  ulimit -f 8
+  "$sph" run "$src/scenes/twisting_column.yaml" --out "$work/fsize" --quiet \
+    --set 'bodies.0.particles.count=[3,7,3]' --set output.png=false \
+    --set time.end=0.3 >/dev/null 2>"$work/stderr"
+)
+rc=$?
+[ $rc -eq 3 ] && grep -q "File too large" "$work/stderr" &&
+  ! ls "$work/fsize" | grep -q '\.part$' && ok || bad "file-size limit: exit $rc: $(cat "$work/stderr")"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "sph/node.h"
@@ -135,6 +136,37 @@ START_TEST(load_file_and_missing_file) {
   ck_assert_ptr_null(root);
   ck_assert_str_eq(err.file, "/nonexistent/x.yaml");
   ck_assert_ptr_nonnull(strstr(err.message, "cannot open"));
+}
+END_TEST
+
+START_TEST(oversized_and_deeply_nested_input_refused_fast) {
+  /* a device or a huge file: refused once past 1 MiB, not read whole */
+  sph_node *root = NULL;
+  sph_error err;
+  ck_assert_int_eq(sph_node_load_file(&root, "/dev/zero", &err), SPH_ERR_RANGE);
+  ck_assert_ptr_nonnull(strstr(err.message, "not a scene"));
+  /* 320 kB of nested brackets: refused before the parser (which needs
+   * seconds for it) at the first bracket too deep */
+  size_t d = 160000, n = 2 * d + 16;
+  char *text = malloc(n);
+  ck_assert_ptr_nonnull(text);
+  memcpy(text, "a: ", 3);
+  memset(text + 3, '[', d);
+  memset(text + 3 + d, ']', d);
+  text[3 + 2 * d] = '\0';
+  clock_t c0 = clock();
+  ck_assert_int_eq(sph_node_load_string(&root, text, "deep", &err),
+                   SPH_ERR_RANGE);
+  ck_assert(clock() - c0 < CLOCKS_PER_SEC / 2);
+  ck_assert_int_eq(err.line, 1);
+  ck_assert_int_eq(err.col, 3 + 65);
+  /* brackets inside quotes and comments do not count */
+  memcpy(text, "a: '", 4);
+  memset(text + 4, '[', 100);
+  memcpy(text + 104, "' # [[[[[[[[\n", 14);
+  ck_assert_int_eq(sph_node_load_string(&root, text, "quoted", &err), SPH_OK);
+  sph_node_destroy(root);
+  free(text);
 }
 END_TEST
 
@@ -719,6 +751,7 @@ int main(void) {
   TCase *tc = tcase_create("node");
   tcase_add_test(tc, positions_and_paths);
   tcase_add_test(tc, load_file_and_missing_file);
+  tcase_add_test(tc, oversized_and_deeply_nested_input_refused_fast);
   tcase_add_test(tc, aliases_are_copied_and_cycles_refused);
   tcase_add_test(tc, duplicate_key_is_an_error);
   tcase_add_test(tc, syntax_errors_have_a_location);
