@@ -153,5 +153,12 @@ rc=$?
 [ $rc -eq 3 ] && grep -q "File too large" "$work/stderr" &&
   ! ls "$work/fsize" | grep -q '\.part$' && ok || bad "file-size limit: exit $rc: $(cat "$work/stderr")"
 
+# a run that cannot fit in memory: refused before allocating, not killed
+# by the kernel (issue 21 item 2)
+"$sph" check "$src/scenes/twisting_column.yaml" \
+  --set 'bodies.0.particles.count=[300,300,300]' 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "GB of memory is available" "$work/stderr" && ok ||
+  bad "oversized run: $(cat "$work/stderr")"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
