@@ -66,8 +66,11 @@ sph_status sph_atomic_commit(sph_atomic_file *af, sph_error *err);
 /* As sph_atomic_open, starting the new file with the first `lines` lines
  * of the earlier <path> (or of its temporary file, if the run that wrote
  * it was killed); fails if it has fewer. */
-sph_status sph_atomic_open_keep(sph_atomic_file *af, const char *path,
-                                size_t lines, sph_error *err);
+/* A stream under its final name (tmp empty: commit closes it in place,
+ * abort keeps it): fresh (lines 0) or keeping the first `lines` complete
+ * lines of the file (a resume). */
+sph_status sph_stream_open(sph_atomic_file *af, const char *path, size_t lines,
+                           sph_error *err);
 /* Flushes and fsyncs the temporary file. */
 sph_status sph_atomic_flush(sph_atomic_file *af, sph_error *err);
 /* Closes and removes the temporary file (safe after a failed commit). */

@@ -1,5 +1,9 @@
 /* Atomic output files: write to "<path>.part", fsync, rename over <path>,
- * so a killed run never leaves a truncated file under the final name. */
+ * so a killed run never leaves a truncated file under the final name.
+ * Streams (the CSV tables): written under the final name and flushed row by
+ * row, so they can be read while the run goes and keep every row written
+ * when it stops; a resume keeps the complete lines its checkpoint counts
+ * (a torn last line is dropped there). */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,6 +32,10 @@ sph_status sph_atomic_commit(sph_atomic_file *af, sph_error *err) {
   int saved = errno;
   bad |= fclose(af->f) != 0;
   af->f = NULL;
+  if (!af->tmp[0]) /* a stream: already under its name */
+    return bad ? sph_error_at(err, SPH_ERR_IO, af->path, 0, 0, NULL,
+                              "cannot write the file: %s", strerror(saved))
+               : SPH_OK;
   if (bad || rename(af->tmp, af->path) != 0) {
     if (!bad)
       saved = errno;
@@ -46,46 +54,56 @@ void sph_atomic_abort(sph_atomic_file *af) {
     remove(af->tmp);
 }
 
-sph_status sph_atomic_open_keep(sph_atomic_file *af, const char *path,
-                                size_t lines, sph_error *err) {
+sph_status sph_stream_open(sph_atomic_file *af, const char *path, size_t lines,
+                           sph_error *err) {
+  memset(af, 0, sizeof *af);
+  snprintf(af->path, sizeof af->path, "%s", path);
   char tmp[1040];
   snprintf(tmp, sizeof tmp, "%s.part", path);
-  FILE *f = fopen(path, "r");
-  if (!f)
-    f = fopen(tmp, "r");
-  if (!f)
-    return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
-                        "cannot resume: neither the file nor its .part "
-                        "exists");
   char *buf = NULL;
-  size_t cap = 0, len = 0, have = 0;
-  for (int ch; have < lines && (ch = fgetc(f)) != EOF;) {
-    if (len + 1 >= cap) {
-      cap = cap ? 2 * cap : 65536;
-      char *nb = realloc(buf, cap);
-      if (!nb) {
-        free(buf);
-        fclose(f);
-        return sph_error_set(err, SPH_ERR_NOMEM, "resume %s", path);
+  size_t len = 0;
+  if (lines > 0) { /* resume: the lines the checkpoint counts */
+    FILE *f = fopen(path, "r");
+    if (!f)
+      f = fopen(tmp, "r"); /* written by an earlier version */
+    if (!f)
+      return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
+                          "cannot resume: the file does not exist");
+    size_t cap = 0, have = 0;
+    for (int ch; have < lines && (ch = fgetc(f)) != EOF;) {
+      if (len + 1 >= cap) {
+        cap = cap ? 2 * cap : 65536;
+        char *nb = realloc(buf, cap);
+        if (!nb) {
+          free(buf);
+          fclose(f);
+          return sph_error_set(err, SPH_ERR_NOMEM, "resume %s", path);
+        }
+        buf = nb;
       }
-      buf = nb;
+      buf[len++] = (char)ch;
+      have += ch == '\n';
     }
-    buf[len++] = (char)ch;
-    have += ch == '\n';
+    fclose(f);
+    if (have < lines) {
+      free(buf);
+      return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
+                          "cannot resume: %zu complete lines, the checkpoint "
+                          "needs %zu",
+                          have, lines);
+    }
   }
-  fclose(f);
-  if (have < lines) {
+  af->f = fopen(path, "w");
+  if (!af->f) {
     free(buf);
     return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
-                        "cannot resume: %zu complete lines, the checkpoint "
-                        "needs %zu",
-                        have, lines);
+                        "cannot create the file: %s", strerror(errno));
   }
-  sph_status st = sph_atomic_open(af, path, err);
-  if (st == SPH_OK && len)
+  remove(tmp);
+  if (len)
     fwrite(buf, 1, len, af->f);
   free(buf);
-  return st;
+  return SPH_OK;
 }
 
 sph_status sph_atomic_flush(sph_atomic_file *af, sph_error *err) {

@@ -1,7 +1,7 @@
 /* CSV sinks: energy.csv (energies and momenta) and probes.csv (the fields
  * each probe asks for, at the particle nearest to the probe in the
- * reference configuration). Both stream to "<name>.part" and are renamed
- * into place on close. */
+ * reference configuration). Both are streams (sph_stream_open): written
+ * under their final names, each row flushed at its output time. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,9 +25,8 @@ static sph_status csv_open(sph_sink *sink, sph_atomic_file *af, const char *dir,
   char path[1024];
   snprintf(path, sizeof path, "%s/%s", dir, name);
   *fresh = sink->resume_frames <= 0;
-  if (*fresh)
-    return sph_atomic_open(af, path, err);
-  return sph_atomic_open_keep(af, path, 1 + (size_t)sink->resume_frames, err);
+  return sph_stream_open(af, path, *fresh ? 0 : 1 + (size_t)sink->resume_frames,
+                         err);
 }
 
 static void csv_destroy(sph_sink *sink) {
@@ -73,6 +72,7 @@ static sph_status energy_write(sph_sink *sink, const sph_frame *fr,
           "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
           fr->time, fr->kinetic, fr->strain, fr->kinetic + fr->strain, lin[0],
           lin[1], lin[2], ang[0], ang[1], ang[2]);
+  fflush(af->f); /* the row is readable now */
   return ferror(af->f) ? sph_error_at(err, SPH_ERR_IO, af->path, 0, 0, NULL,
                                       "cannot write")
                        : SPH_OK;
@@ -161,6 +161,7 @@ static sph_status probe_write(sph_sink *sink, const sph_frame *fr,
     }
   }
   fputc('\n', p->af.f);
+  fflush(p->af.f); /* the row is readable now */
   return ferror(p->af.f) ? sph_error_at(err, SPH_ERR_IO, p->af.path, 0, 0, NULL,
                                         "cannot write")
                          : SPH_OK;

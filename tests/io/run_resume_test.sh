@@ -5,7 +5,8 @@
 # numbers as an uninterrupted run (serial, bit-identical) for every method;
 # damaged, missing and mismatched checkpoints are refused; a write failure
 # (file size limit standing in for a full disk) stops the run with an error
-# naming the file and leaves no temporary file behind.
+# naming the file, keeps the rows written and leaves no temporary file
+# behind, and the run resumes once the space is back.
 set -u
 sph=$1
 src=$2
@@ -105,19 +106,28 @@ echo "refusals: checked"
 
 # a write failure mid-run (file size limit as a full disk): energy.csv
 # outgrows 10 KiB after about 40 rows, every other file stays below (so
-# coarse a column is not judged by the zig-zag indicator)
+# coarse a column is not judged by the zig-zag indicator); the rows written
+# stay, and once the space is back --resume finishes the run with the
+# files of an uninterrupted one
 full=$work/full
-out=$(trap '' XFSZ; ulimit -f 10; "$sph" run "$scene" --out "$full" --quiet \
-  --set time.end=0.3 --set output.checkpoint_every=0.02 \
-  --set 'bodies.0.particles.count=[3,7,3]' 2>&1)
+small=(--quiet --set time.end=0.3 --set output.checkpoint_every=0.02
+  --set 'bodies.0.particles.count=[3,7,3]' --set output.png=false)
+out=$(trap '' XFSZ; ulimit -f 10; "$sph" run "$scene" --out "$full" "${small[@]}" 2>&1)
 rc=$?
 [ $rc -ne 0 ] || fail "write failure: exit 0"
-echo "$out" | grep -q "$full/" || fail "write failure: message does not name the file: '$out'"
+echo "$out" | grep -q "$full/energy.csv" || fail "write failure: message does not name the file: '$out'"
 ls "$full" | grep -q '\.part$' && fail "write failure: temporary files left: $(ls "$full" | grep part)"
 [ -f "$full/summary.json" ] && fail "write failure: summary.json written"
 "${check[@]}" --series "$full" twisting_column >/dev/null ||
   fail "write failure: the frames written before it do not read cleanly"
-echo "write failure: $(echo "$out" | head -1)"
+rows=$(wc -l <"$full/energy.csv")
+[ "$rows" -gt 30 ] || fail "write failure: energy.csv kept $rows lines"
+echo "write failure: $(echo "$out" | head -1); energy.csv kept $rows lines"
+"$sph" run "$scene" --out "$work/full-whole" "${small[@]}" >/dev/null || fail "uninterrupted small run"
+"$sph" run "$scene" --resume "$full" "${small[@]}" >/dev/null || fail "resume after the write failure"
+for f in energy.csv probes.csv twisting_column.pvd twisting_column_0060.vtp; do
+  cmp -s "$work/full-whole/$f" "$full/$f" || fail "$f differs after the resume from a full disk"
+done
 
 echo "$fails failures"
 [ $fails -eq 0 ]
