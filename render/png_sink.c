@@ -51,6 +51,7 @@
 #include "sph/geometry.h"
 #include "sph/image.h"
 #include "sph/render.h"
+#include "sph/vtk_read.h"
 
 /* One frame as the simulation thread hands it to the renderer. */
 typedef struct png_frame {
@@ -661,6 +662,9 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   return SPH_OK;
 }
 
+static void png_replay(png_sink *p, const sph_sim *sim, const char *dir,
+                       int frames);
+
 static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
                               const char *dir, int threaded, sph_error *err) {
   png_sink *p = calloc(1, sizeof *p);
@@ -670,6 +674,7 @@ static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
   sink->thread_seconds = 0.0;
   p->threaded = threaded;
   SPH_TRY(png_setup(p, sim, dir, err));
+  png_replay(p, sim, dir, sink->resume_frames);
   if (!threaded)
     return png_renderer_create(p, err);
   /* the render thread, which makes the GL context current on itself */
@@ -725,6 +730,71 @@ static void png_follow(png_sink *p, const float *xyz, size_t m) {
   memcpy(p->fit_lo, lo, sizeof lo);
   memcpy(p->fit_hi, hi, sizeof hi);
   png_fit(p->scene, lo, hi, &p->view);
+}
+
+/* auto and symmetric: a frame widens the range when its values exceed it */
+static void png_grow_range(png_sink *p, double vmin, double vmax, double amax) {
+  if (p->mode == PNG_RANGE_FIXED || p->mode == PNG_RANGE_ROBUST ||
+      !(vmax > vmin))
+    return;
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  int sym = p->mode == PNG_RANGE_SYMMETRIC;
+  double lo_f = sym ? c0 - amax : vmin, hi_f = sym ? c0 + amax : vmax;
+  p->lo = p->have_range ? fmin(p->lo, lo_f) : lo_f;
+  p->hi = p->have_range ? fmax(p->hi, hi_f) : hi_f;
+  p->have_range = 1;
+}
+
+/* A resumed run's frames continue the camera and the grow-only range of
+ * the frames already written: both are replayed from their .vtp files
+ * (the positions and, for a grow-only range, the colour field), so the
+ * frames equal an uninterrupted run's. Without the files (vtk off, or the
+ * field not among output.fields) they restart from the first frame's. */
+static void png_replay(png_sink *p, const sph_sim *sim, const char *dir,
+                       int frames) {
+  int grow = p->mode == PNG_RANGE_AUTO || p->mode == PNG_RANGE_SYMMETRIC;
+  if (frames <= 0 || !(p->follow || grow) || !sim->scene->output.vtk)
+    return;
+  const sph_particles *ps = sim->ps;
+  size_t n = ps->n, m = 0;
+  double *x = malloc(3 * (n ? n : 1) * sizeof *x);
+  double *v = malloc((size_t)p->ncomp * (n ? n : 1) * sizeof *v);
+  float *xyz = malloc(3 * (p->nkeep ? p->nkeep : 1) * sizeof *xyz);
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  for (int i = 0; x && v && xyz && i < frames; ++i) {
+    char path[1300];
+    double t;
+    sph_error err;
+    snprintf(path, sizeof path, "%s/%s_%04d.vtp", dir, sim->scene->name, i);
+    if (sph_vtp_read(path, n, x,
+                     grow ? sph_field_name((sph_field)p->field) : NULL,
+                     p->ncomp, v, &t, &err) != SPH_OK)
+      break;
+    double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
+    m = 0;
+    for (size_t j = 0; j < n; ++j) {
+      if (grow) {
+        double val = sph_png_value(v, p->ncomp, j);
+        if (isfinite(val)) {
+          vmin = fmin(vmin, val);
+          vmax = fmax(vmax, val);
+          amax = fmax(amax, fabs(val - c0));
+        }
+      }
+      if (!p->keep[sph_particles_slot(ps, j)])
+        continue;
+      for (int c = 0; c < 3; ++c)
+        xyz[3 * m + c] = (float)x[3 * j + c];
+      ++m;
+    }
+    if (grow)
+      png_grow_range(p, vmin, vmax, amax);
+    if (p->follow)
+      png_follow(p, xyz, m);
+  }
+  free(x);
+  free(v);
+  free(xyz);
 }
 
 /* Copies what frame fr needs into snapshot s and advances the range (frame
@@ -785,13 +855,8 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
     p->lo = lo_f;
     p->hi = hi_f;
     p->have_range = 1;
-  } else if (p->mode != PNG_RANGE_FIXED && p->mode != PNG_RANGE_ROBUST &&
-             vmax > vmin) { /* grow-only */
-    int sym = p->mode == PNG_RANGE_SYMMETRIC;
-    double lo_f = sym ? c0 - amax : vmin, hi_f = sym ? c0 + amax : vmax;
-    p->lo = p->have_range ? fmin(p->lo, lo_f) : lo_f;
-    p->hi = p->have_range ? fmax(p->hi, hi_f) : hi_f;
-    p->have_range = 1;
+  } else {
+    png_grow_range(p, vmin, vmax, amax);
   }
   s->lo = p->have_range ? p->lo : (diverging ? c0 - 1.0 : 0.0);
   s->hi = p->have_range ? p->hi : (diverging ? c0 + 1.0 : 1.0);
