@@ -321,6 +321,35 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
   return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
 }
 
+sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+                                sph_error *err) {
+  const sph_scene *s = sim->scene;
+  size_t ne = ref->n_ext;
+  /* neighbours and corrected gradients in the reference configuration */
+  SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
+                              sim->kernel.support, ref->body,
+                              SPH_PAIRS_SAME_BODY, err));
+  if (ref->nl->count + 1 > ref->w_cap) { /* grows only, amortised */
+    size_t cap = 2 * (ref->nl->count + 1);
+    double *w = realloc(ref->w, cap * sizeof *w);
+    if (!w)
+      return sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
+    ref->w = w;
+    ref->w_cap = cap;
+  }
+  sph_cloud cloud = {.n = ne,
+                     .dim = s->dimension,
+                     .x = ref->X,
+                     .volume = ref->V,
+                     .id = ref->id,
+                     .nl = ref->nl,
+                     .kernel = &sim->kernel};
+  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL,
+                                  ref->L, err));
+  pair_weights(ref, &sim->kernel);
+  return SPH_OK;
+}
+
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                sph_error *err) {
   memset(ref, 0, sizeof *ref);
@@ -400,38 +429,19 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   }
   tl_mirror_refresh(ref, ref->x, ref->p, ref->F, NULL, ref->J);
 
-  /* neighbours and corrected gradients in the reference configuration */
-  SPH_TRY(sph_neighbors_create(&ref->nl, err));
-  SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
-                              sim->kernel.support, ref->body,
-                              SPH_PAIRS_SAME_BODY, err));
   int64_t *id = malloc(ne * sizeof *id);
   if (!id)
     return sph_error_set(err, SPH_ERR_NOMEM, "ids");
   for (size_t a = 0; a < ne; ++a)
     id[a] = ps->id[ref->src[a]];
-  sph_cloud cloud = {.n = ne,
-                     .dim = s->dimension,
-                     .x = ref->X,
-                     .volume = ref->V,
-                     .id = id,
-                     .nl = ref->nl,
-                     .kernel = &sim->kernel};
-  ref->w = malloc((ref->nl->count + 1) * sizeof *ref->w);
+  ref->id = id;
   ref->s = calloc(3 * n + 3, sizeof *ref->s);
-  sph_status st = SPH_OK;
-  if (!ref->w || !ref->s)
-    st = sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
-  if (st == SPH_OK)
-    st = tl_reference_alloc(ref, 9, &ref->L, err);
-  if (st == SPH_OK)
-    st = tl_reference_alloc(ref, 9, &ref->Qt, err);
-  if (st == SPH_OK)
-    st = sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL, ref->L,
-                                 err);
-  if (st == SPH_OK)
-    pair_weights(ref, &sim->kernel);
-  free(id);
+  if (!ref->s)
+    return sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
+  SPH_TRY(tl_reference_alloc(ref, 9, &ref->L, err));
+  SPH_TRY(tl_reference_alloc(ref, 9, &ref->Qt, err));
+  SPH_TRY(sph_neighbors_create(&ref->nl, err));
+  sph_status st = tl_reference_rebuild(ref, sim, err);
   sim->timers[timer].seconds += sph_wtime() - t0;
   sim->timers[timer].calls++;
   return st;
@@ -439,6 +449,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
 
 void tl_reference_destroy(tl_reference *ref) {
   sph_neighbors_destroy(ref->nl);
+  free(ref->id);
   free(ref->w);
   free(ref->L);
   free(ref->s);

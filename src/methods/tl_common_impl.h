@@ -23,6 +23,8 @@ typedef struct tl_reference {
   int32_t *body;            /* bodies (n_ext) */
   sph_neighbors *nl;        /* over all n_ext points, same body only */
   double *w;                /* V_b W'(r_ab) / r_ab per slot */
+  size_t w_cap;             /* slots w holds */
+  int64_t *id;              /* particle id per point (n_ext) */
   double *L;                /* correction matrix per point (9 n_ext) */
   double *s;                /* sum_b w_ab r_ab per particle (3 n) */
   const sph_material **mat; /* per point (n_ext) */
@@ -51,6 +53,12 @@ typedef struct tl_reference {
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                sph_error *err);
 void tl_reference_destroy(tl_reference *ref);
+
+/* Neighbour lists, correction matrices L, pair weights w and sums s from
+ * the current X and V (the updated-Lagrangian methods call it at each
+ * reference update; w grows only when the pair count exceeds it). */
+sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+                                sph_error *err);
 
 /* Slot of (b -> a) for every slot (a -> b), for pair quantities that are
  * not antisymmetric (allocated here, freed by the caller). */

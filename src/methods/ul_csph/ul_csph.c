@@ -1,0 +1,251 @@
+/* ul-csph: the updated-Lagrangian corrected SPH of seed 001 sec. 3.1
+ * (Vidal, Bonet, Huerta 2007): every `update_every` steps the current
+ * configuration becomes the reference x^r (new neighbours and corrected
+ * gradients, eq. 13; F^r = F kept as state; V^r = J^r V^0, Remark 1); in
+ * between the incremental f = sum_b x_b g_b^T(x^r) (eq. 12) gives
+ * F = f F^r and the internal force is eq. 14,
+ * T_i = sum_j V^0_j P_j [F^r_j]^T g_i(x^r_j), m a = E - T, leap-frog as
+ * tl-csph. This is the standard updated formulation, without the Hessian
+ * stabilisation of sec. 3.4: its zero-energy mechanisms (sec. 3.2-3.3)
+ * are left for the verdict to see. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/registry_impl.h"
+#include "methods/ul_csph/ul_csph_iact.h"
+#include "methods/ul_csph/ul_csph_impl.h"
+#include "sph/tensor.h"
+#include "terms/terms_impl.h"
+
+/* F = f F^r from the positions, images mirrored, P and the force matrix for
+ * every point */
+static void deformation_and_stress(ul_csph *m, long n) {
+  tl_reference *ref = &m->ref;
+  long ne = (long)ref->n_ext;
+  if (ne > n)
+    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    tl_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
+    tl_pair_sums(ref, (size_t)a, m->x, 0, &s);
+    double f[9], unused[3];
+    tl_sums_store(&s, f, unused);
+    tl_iact_gradient_correct(f, ref->L + 9 * a);
+    ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
+  }
+  if (ne > n)
+    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    double H[9];
+    sph_mat3_cofactor(m->F + 9 * a, H);
+    sph_material_stress(ref->mat[a], m->F + 9 * a, H,
+                        sph_mat3_det(m->F + 9 * a), m->P + 9 * a);
+    ul_iact_force_matrix(m->P + 9 * a, m->Fr + 9 * a, m->Jr[a], ref->L + 9 * a,
+                         ref->Qt + 9 * a);
+  }
+}
+
+static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
+  ul_csph *m = ctx;
+  sph_sim *sim = m->sim;
+  long n = (long)sim->ps->n;
+  double t0 = sph_wtime();
+  deformation_and_stress(m, n);
+  tl_conservative_force(&m->ref, m->dp);
+  /* per initial volume: dp_i = -T_i / V^0_i = J^r_i (-T_i / V^r_i) */
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c)
+      m->dp[3 * a + c] *= m->Jr[a];
+  sim->timers[m->timer_force].seconds += sph_wtime() - t0;
+  sim->timers[m->timer_force].calls++;
+  sph_stage s = {
+      .t = t, .x = m->x, .p = m->p, .F = m->F, .x_moment = m->x, .dp = m->dp};
+  return sph_sim_terms_rates(sim, &s, err);
+}
+
+static sph_status ul_csph_constrain(void *ctx, double t, sph_error *err) {
+  ul_csph *m = ctx;
+  sph_stage s = {.t = t, .x = m->x, .p = m->p, .F = m->F};
+  return sph_sim_terms_constrain(m->sim, &s, err);
+}
+
+/* V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
+static sph_status rebuild(ul_csph *m, sph_error *err) {
+  tl_reference *ref = &m->ref;
+  long ne = (long)ref->n_ext;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    m->Jr[a] = sph_mat3_det(m->Fr + 9 * a);
+    ref->V[a] = m->Jr[a] * m->V0[a];
+  }
+  return tl_reference_rebuild(ref, m->sim, err);
+}
+
+/* x^r = x^n and F^r = F^n (seed 001 sec. 3.1, Fig. 8), timed on its own */
+static sph_status reference_update(ul_csph *m, sph_error *err) {
+  sph_sim *sim = m->sim;
+  tl_reference *ref = &m->ref;
+  double t0 = sph_wtime();
+  deformation_and_stress(m, (long)ref->n);
+  memcpy(ref->X, m->x, 3 * ref->n_ext * sizeof *ref->X);
+  memcpy(m->Fr, m->F, 9 * ref->n_ext * sizeof *m->Fr);
+  sph_status st = rebuild(m, err);
+  m->lf.have_rates = 0; /* the rates of the new reference */
+  m->since = 0.0;
+  sim->timers[m->timer_update].seconds += sph_wtime() - t0;
+  sim->timers[m->timer_update].calls++;
+  return st;
+}
+
+static double ul_csph_stable_dt(sph_sim *sim) {
+  const ul_csph *m = sim->method_data;
+  return tl_stable_dt(&m->ref, sim, m->cfl, 1);
+}
+
+static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
+  ul_csph *m = sim->method_data;
+  if (m->since >= m->update_every)
+    SPH_TRY(reference_update(m, err));
+  SPH_TRY(sph_leapfrog_step(&m->lf, sim->t, dt, err));
+  m->since += 1.0;
+  return tl_check_finite(&m->ref, err);
+}
+
+static sph_status ul_csph_derive(sph_sim *sim, sph_error *err) {
+  ul_csph *m = sim->method_data;
+  deformation_and_stress(m, (long)sim->ps->n);
+  tl_derive(sim, &m->ref, NULL, NULL);
+  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
+    if (!m->lf.have_rates)
+      SPH_TRY(m->lf.rates(m->lf.ctx, sim->t, err));
+    tl_acceleration(sim, &m->ref, m->dp);
+  }
+  return SPH_OK;
+}
+
+static void ul_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
+  ul_csph *m = sim->method_data;
+  tl_reference initial = m->ref; /* energy per initial volume */
+  initial.V = m->V0;
+  tl_energy(sim, &initial, NULL, NULL, kinetic, strain);
+}
+
+static void ul_csph_destroy(sph_sim *sim) {
+  ul_csph *m = sim->method_data;
+  if (!m)
+    return;
+  tl_reference_destroy(&m->ref);
+  free(m->V0);
+  free(m->Fr);
+  free(m->Jr);
+  free(m->dp);
+  free(m);
+  sim->method_data = NULL;
+}
+
+static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  static const char *const keys[] = {"name", "cfl", "integrator",
+                                     "update_every", NULL};
+  SPH_TRY(sph_node_check_keys(opt, keys, err));
+  ul_csph *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph");
+  sim->method_data = m;
+  m->sim = sim;
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
+  if (!(m->cfl > 0.0 && m->cfl <= 1.0))
+    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
+                          "cfl must be in (0, 1], got %g", m->cfl);
+  long every;
+  SPH_TRY(sph_node_get_int(opt, "update_every", 0, 1, &every, err));
+  if (every < 1 || every > 1000000000L)
+    return sph_node_error(sph_node_child(opt, "update_every"), err,
+                          SPH_ERR_RANGE,
+                          "update_every must be a number of steps >= 1, got "
+                          "%ld",
+                          every);
+  m->update_every = (int)every;
+  const char *integ;
+  SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
+  if (strcmp(integ, "leapfrog"))
+    return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
+                          "'%s' is not one of: leapfrog", integ);
+  const sph_scene *s = sim->scene;
+  SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
+  sph_particles *ps = sim->ps;
+  size_t ne = m->ref.n_ext;
+  m->x = m->ref.x;
+  m->p = m->ref.p;
+  m->F = m->ref.F;
+  m->P = m->ref.P;
+  m->dp = calloc(3 * ps->n + 3, sizeof *m->dp);
+  m->V0 = malloc((ne + 1) * sizeof *m->V0);
+  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->Fr, err));
+  SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->Jr, err));
+  if (!m->dp || !m->V0)
+    return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph state");
+  memcpy(m->V0, m->ref.V, ne * sizeof *m->V0);
+  /* the initial reference is X with F^r the initial F (I unless given) */
+  memcpy(m->Fr, m->F, 9 * ne * sizeof *m->Fr);
+  m->timer_force = sph_sim_add_timer(sim, "internal_force");
+  m->timer_update = sph_sim_add_timer(sim, "reference_update");
+  if (sim->initial_defgrad) /* the given deformed state is x^r */
+    memcpy(m->ref.X, m->x, 3 * ne * sizeof *m->ref.X);
+  SPH_TRY(rebuild(m, err));
+  m->lf = (sph_leapfrog){.n = ps->n,
+                         .x = m->x,
+                         .p = m->p,
+                         .dp = m->dp,
+                         .rho0 = m->ref.rho0,
+                         .rates = ul_csph_rates,
+                         .constrain = ul_csph_constrain,
+                         .ctx = m};
+  if (s->has_body_force)
+    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
+  if (sph_scene_has_essential_bc(s)) {
+    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
+    SPH_TRY(ul_csph_constrain(m, 0.0, err));
+  }
+  return SPH_OK;
+}
+
+static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
+  ul_csph *m = sim->method_data;
+  size_t n = m->ref.n, ne = m->ref.n_ext;
+  out[0] = (sph_state_array){"x", m->x, 3 * n};
+  out[1] = (sph_state_array){"p", m->p, 3 * n};
+  out[2] = (sph_state_array){"F", m->F, 9 * n};
+  /* the reference configuration, images included */
+  out[3] = (sph_state_array){"Xr", m->ref.X, 3 * ne};
+  out[4] = (sph_state_array){"Fr", m->Fr, 9 * ne};
+  out[5] = (sph_state_array){"since_update", &m->since, 1};
+  return 6;
+}
+
+static sph_status ul_csph_restore(sph_sim *sim, sph_error *err) {
+  ul_csph *m = sim->method_data;
+  double t0 = sph_wtime();
+  sph_status st = rebuild(m, err);
+  m->lf.have_rates = 0;
+  sim->timers[m->timer_update].seconds += sph_wtime() - t0;
+  sim->timers[m->timer_update].calls++;
+  return st;
+}
+
+const sph_method_ops ul_csph_method_ops = {
+    .name = "ul-csph",
+    .title = "Updated-Lagrangian corrected SPH with reference updates",
+    .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 3.1, eq. 12-14",
+    .conserves_angular_momentum = 1,
+    .setup = ul_csph_setup,
+    .stable_dt = ul_csph_stable_dt,
+    .step = ul_csph_step,
+    .derive = ul_csph_derive,
+    .energy = ul_csph_energy,
+    .state = ul_csph_state,
+    .restore = ul_csph_restore,
+    .destroy = ul_csph_destroy,
+};
