@@ -18,6 +18,7 @@
 static void deformation_and_stress(tl_csph *m, long n) {
   tl_reference *ref = &m->ref;
   long ne = (long)ref->n_ext;
+  int dim = m->sim->scene->dimension;
   if (ne > n) /* image positions and momenta from their sources */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
@@ -27,6 +28,7 @@ static void deformation_and_stress(tl_csph *m, long n) {
     double F[9], unused[3];
     tl_sums_store(&s, F, unused);
     tl_iact_gradient_correct(F, ref->L + 9 * a);
+    tl_iact_plane_strain(F, dim);
     memcpy(m->F + 9 * a, F, sizeof F);
   }
   if (ne > n) /* the images' F mirror their sources' */

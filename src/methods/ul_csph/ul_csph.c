@@ -23,6 +23,7 @@
 static void deformation_and_stress(ul_csph *m, long n) {
   tl_reference *ref = &m->ref;
   long ne = (long)ref->n_ext;
+  int dim = m->sim->scene->dimension;
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
@@ -32,6 +33,7 @@ static void deformation_and_stress(ul_csph *m, long n) {
     double f[9], unused[3];
     tl_sums_store(&s, f, unused);
     tl_iact_gradient_correct(f, ref->L + 9 * a);
+    tl_iact_plane_strain(f, dim);
     ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
   }
   if (ne > n)
