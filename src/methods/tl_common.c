@@ -244,6 +244,18 @@ sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **out,
   size_t *rev = malloc((nl->count ? nl->count : 1) * sizeof *rev);
   if (!rev)
     return sph_error_set(err, SPH_ERR_NOMEM, "reverse slots");
+  sph_status st = tl_reference_reverse_fill(ref, rev, err);
+  if (st != SPH_OK) {
+    free(rev);
+    return st;
+  }
+  *out = rev;
+  return SPH_OK;
+}
+
+sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
+                                     sph_error *err) {
+  const sph_neighbors *nl = ref->nl;
   long n = (long)nl->n, missing = 0;
 #pragma omp parallel for schedule(static) reduction(+ : missing)
   for (long a = 0; a < n; ++a)
@@ -262,11 +274,8 @@ sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **out,
       else
         ++missing;
     }
-  if (missing) {
-    free(rev);
+  if (missing)
     return sph_error_set(err, SPH_ERR_ARG, "neighbour lists are not symmetric");
-  }
-  *out = rev;
   return SPH_OK;
 }
 

@@ -64,6 +64,9 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
  * not antisymmetric (allocated here, freed by the caller). */
 sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **rev,
                                       sph_error *err);
+/* The same into rev of at least nl->count entries. */
+sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
+                                     sph_error *err);
 
 /* Corrected gradient grad_b(X_a) of slot k of particle a (set-up use). */
 void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,

@@ -1,13 +1,15 @@
-/* ul-csph: the updated-Lagrangian corrected SPH of seed 001 sec. 3.1
- * (Vidal, Bonet, Huerta 2007): every `update_every` steps the current
- * configuration becomes the reference x^r (new neighbours and corrected
- * gradients, eq. 13; F^r = F kept as state; V^r = J^r V^0, Remark 1); in
- * between the incremental f = sum_b x_b g_b^T(x^r) (eq. 12) gives
- * F = f F^r and the internal force is eq. 14,
+/* ul-csph: the stabilised updated-Lagrangian corrected SPH of seed 001
+ * sec. 3-4 (Vidal, Bonet, Huerta 2007): every `update_every` steps the
+ * current configuration becomes the reference x^r (new neighbours and
+ * corrected gradients, eq. 13; F^r = F kept as state; V^r = J^r V^0,
+ * Remark 1); in between the incremental f = sum_b x_b g_b^T(x^r) (eq. 12)
+ * gives F = f F^r and the internal force is eq. 14,
  * T_i = sum_j V^0_j P_j [F^r_j]^T g_i(x^r_j), m a = E - T, leap-frog as
- * tl-csph. This is the standard updated formulation, without the Hessian
- * stabilisation of sec. 3.4: its zero-energy mechanisms (sec. 3.2-3.3)
- * are left for the verdict to see. */
+ * tl-csph. With eta > 0 the gradients are the Hessian-difference
+ * stabilised ones of sec. 3.4 (eq. 17-21: linearly corrected kernel
+ * Hessian, h of Remark 2) in f and, as the adjoint of that map, in the
+ * force; eta = 0 is the standard updated formulation of sec. 3.1, whose
+ * zero-energy mechanisms (sec. 3.2-3.3) are left for the verdict to see. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,12 +20,13 @@
 #include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
-/* F = f F^r from the positions, images mirrored, P and the force matrix for
- * every point */
+/* f (eq. 12-13, stabilised by eq. 17 / 21 when eta > 0), F = f F^r, images
+ * mirrored, P, S = P F^r^T / J^r and the force matrices for every point */
 static void deformation_and_stress(ul_csph *m, long n) {
   tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
   long ne = (long)ref->n_ext;
-  int dim = m->sim->scene->dimension;
+  int dim = m->sim->scene->dimension, stab = m->eta > 0.0;
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
@@ -34,7 +37,28 @@ static void deformation_and_stress(ul_csph *m, long n) {
     tl_sums_store(&s, f, unused);
     tl_iact_gradient_correct(f, ref->L + 9 * a);
     tl_iact_plane_strain(f, dim);
-    ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
+    if (stab)
+      memcpy(m->f0 + 9 * a, f, sizeof f);
+    else
+      ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
+  }
+  if (stab) {
+    if (ne > n)
+      tl_mirror_refresh(ref, m->x, m->p, m->f0, NULL, NULL);
+#pragma omp parallel for schedule(static)
+    for (long a = 0; a < n; ++a) {
+      double acc[9] = {0}, f[9];
+      const double *f0a = m->f0 + 9 * a;
+      for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+        size_t b = (size_t)nl->index[k];
+        ul_iact_stab_defgrad(acc, ref->V[b], m->x + 3 * a, m->x + 3 * b,
+                             m->hv + 3 * k, m->gh[k], f0a, m->f0 + 9 * b);
+      }
+      for (int c = 0; c < 9; ++c)
+        f[c] = f0a[c] + m->eta * acc[c];
+      tl_iact_plane_strain(f, dim);
+      ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
+    }
   }
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
@@ -44,8 +68,44 @@ static void deformation_and_stress(ul_csph *m, long n) {
     sph_mat3_cofactor(m->F + 9 * a, H);
     sph_material_stress(ref->mat[a], m->F + 9 * a, H,
                         sph_mat3_det(m->F + 9 * a), m->P + 9 * a);
-    ul_iact_force_matrix(m->P + 9 * a, m->Fr + 9 * a, m->Jr[a], ref->L + 9 * a,
+    ul_iact_reference_stress(m->P + 9 * a, m->Fr + 9 * a, m->Jr[a],
+                             m->S + 9 * a);
+    if (!stab)
+      ul_iact_force_matrix(m->S + 9 * a, m->S + 9 * a, 0.0, ref->L + 9 * a,
+                           ref->Qt + 9 * a);
+  }
+  if (!stab)
+    return;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    double Y[9] = {0}; /* adjoint of the f0 difference term */
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t j = (size_t)nl->index[k];
+      ul_iact_stab_adjoint(Y, m->gh[m->rev[k]], ref->V[j], m->S + 9 * j);
+    }
+    for (int c = 0; c < 9; ++c)
+      Y[c] -= m->sgh[a] * ref->V[a] * m->S[9 * a + c];
+    ul_iact_force_matrix(m->S + 9 * a, Y, m->eta / ref->V[a], ref->L + 9 * a,
                          ref->Qt + 9 * a);
+  }
+}
+
+/* the Hessian term's share of the force (adjoint of eq. 21's first
+ * stabilisation term) */
+static void stabilisation_force(ul_csph *m, long n) {
+  const tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double out[3] = {0, 0, 0}, self[3];
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t j = (size_t)nl->index[k];
+      ul_iact_stab_hessian_force(out, ref->V[j], m->S + 9 * j,
+                                 m->hv + 3 * m->rev[k]);
+    }
+    sph_mat3_vec(m->S + 9 * a, m->sv + 3 * a, self);
+    for (int c = 0; c < 3; ++c)
+      m->dp[3 * a + c] -= m->eta * (out[c] - self[c]);
   }
 }
 
@@ -56,7 +116,9 @@ static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
   double t0 = sph_wtime();
   deformation_and_stress(m, n);
   tl_conservative_force(&m->ref, m->dp);
-  /* per initial volume: dp_i = -T_i / V^0_i = J^r_i (-T_i / V^r_i) */
+  if (m->eta > 0.0)
+    stabilisation_force(m, n);
+    /* per initial volume: dp_i = -T_i / V^0_i = J^r_i (-T_i / V^r_i) */
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
@@ -74,6 +136,80 @@ static sph_status ul_csph_constrain(void *ctx, double t, sph_error *err) {
   return sph_sim_terms_constrain(m->sim, &s, err);
 }
 
+/* Per slot H~_k(x_a) h = H_k h + (A . (x_a - x_k)) h with the linear
+ * correction A of eq. 19 contracted with h (the B of eq. 20 drops out of
+ * the difference form), and g_k(x_a).h; per point their sums */
+static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
+  tl_reference *ref = &m->ref;
+  const sph_neighbors *nl = ref->nl;
+  const sph_kernel *kernel = &m->sim->kernel;
+  if (nl->count + 1 > m->slot_cap) { /* grows only, amortised */
+    size_t cap = 2 * (nl->count + 1);
+    double *hv = realloc(m->hv, 3 * cap * sizeof *hv);
+    if (hv)
+      m->hv = hv;
+    double *gh = realloc(m->gh, cap * sizeof *gh);
+    if (gh)
+      m->gh = gh;
+    size_t *rev = realloc(m->rev, cap * sizeof *rev);
+    if (rev)
+      m->rev = rev;
+    if (!hv || !gh || !rev)
+      return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph stabilisation");
+    m->slot_cap = cap;
+  }
+  SPH_TRY(tl_reference_reverse_fill(ref, m->rev, err));
+  int dim = m->sim->scene->dimension;
+  long ne = (long)ref->n_ext;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    const double *Xa = ref->X + 3 * a;
+    double C[9] = {0}, D[9] = {0}, Dinv[9] = {0}, M[9];
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3], d;
+      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      d = sqrt(sph_vec3_dot(r, r));
+      double *hv = m->hv + 3 * k;
+      if (d > 0.0)
+        ul_iact_hessian_h(r, d, sph_kernel_dwdr(kernel, d),
+                          sph_kernel_d2wdr2(kernel, d), m->h, hv);
+      else
+        hv[0] = hv[1] = hv[2] = 0.0;
+      /* C = sum V_k (H_k h) (x) (x_k - x_a), D = sum V_k r r^T */
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          C[3 * i + j] -= ref->V[b] * hv[i] * r[j];
+          D[3 * i + j] += ref->V[b] * r[i] * r[j];
+        }
+    }
+    for (int c = dim; c < 3; ++c)
+      D[4 * c] = 1.0; /* no moment across the plane of a 2D body */
+    sph_mat3_inverse(D, Dinv);
+    sph_mat3_mul(C, Dinv, M);
+    double sv[3] = {0, 0, 0}, sgh = 0.0;
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double r[3], Mr[3], g[3];
+      for (int c = 0; c < 3; ++c)
+        r[c] = Xa[c] - ref->X[3 * b + c];
+      sph_mat3_vec(M, r, Mr);
+      double *hv = m->hv + 3 * k;
+      for (int c = 0; c < 3; ++c) {
+        hv[c] += Mr[c];
+        sv[c] += ref->V[b] * hv[c];
+        r[c] *= ref->w[k];
+      }
+      sph_mat3_vec(ref->L + 9 * a, r, g); /* g_k(x_a), eq. 13 */
+      m->gh[k] = sph_vec3_dot(g, m->h);
+      sgh += m->gh[k];
+    }
+    memcpy(m->sv + 3 * a, sv, sizeof sv);
+    m->sgh[a] = sgh;
+  }
+  return SPH_OK;
+}
+
 /* V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
 static sph_status rebuild(ul_csph *m, sph_error *err) {
   tl_reference *ref = &m->ref;
@@ -83,7 +219,8 @@ static sph_status rebuild(ul_csph *m, sph_error *err) {
     m->Jr[a] = sph_mat3_det(m->Fr + 9 * a);
     ref->V[a] = m->Jr[a] * m->V0[a];
   }
-  return tl_reference_rebuild(ref, m->sim, err);
+  SPH_TRY(tl_reference_rebuild(ref, m->sim, err));
+  return m->eta > 0.0 ? stabilisation_setup(m, err) : SPH_OK;
 }
 
 /* x^r = x^n and F^r = F^n (seed 001 sec. 3.1, Fig. 8), timed on its own */
@@ -143,14 +280,21 @@ static void ul_csph_destroy(sph_sim *sim) {
   free(m->V0);
   free(m->Fr);
   free(m->Jr);
+  free(m->hv);
+  free(m->gh);
+  free(m->rev);
+  free(m->sv);
+  free(m->sgh);
+  free(m->f0);
+  free(m->S);
   free(m->dp);
   free(m);
   sim->method_data = NULL;
 }
 
 static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
-  static const char *const keys[] = {"name", "cfl", "integrator",
-                                     "update_every", NULL};
+  static const char *const keys[] = {"name",         "cfl", "integrator",
+                                     "update_every", "eta", NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   ul_csph *m = calloc(1, sizeof *m);
   if (!m)
@@ -170,6 +314,10 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "%ld",
                           every);
   m->update_every = (int)every;
+  SPH_TRY(sph_node_get_double(opt, "eta", 0, 0.3, &m->eta, err));
+  if (!(m->eta >= 0.0 && m->eta <= 100.0))
+    return sph_node_error(sph_node_child(opt, "eta"), err, SPH_ERR_RANGE,
+                          "eta must be in [0, 100], got %g", m->eta);
   const char *integ;
   SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
   if (strcmp(integ, "leapfrog"))
@@ -187,6 +335,13 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->V0 = malloc((ne + 1) * sizeof *m->V0);
   SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->Fr, err));
   SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->Jr, err));
+  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->S, err));
+  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->f0, err));
+  SPH_TRY(tl_reference_alloc(&m->ref, 3, &m->sv, err));
+  SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->sgh, err));
+  /* h of Remark 2: the smoothing length along each axis of the body */
+  for (int c = 0; c < s->dimension; ++c)
+    m->h[c] = sim->kernel.h;
   if (!m->dp || !m->V0)
     return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph state");
   memcpy(m->V0, m->ref.V, ne * sizeof *m->V0);
@@ -239,8 +394,8 @@ static sph_status ul_csph_restore(sph_sim *sim, sph_error *err) {
 
 const sph_method_ops ul_csph_method_ops = {
     .name = "ul-csph",
-    .title = "Updated-Lagrangian corrected SPH with reference updates",
-    .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 3.1, eq. 12-14",
+    .title = "Stabilised updated-Lagrangian corrected SPH",
+    .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 3-4, eq. 12-21",
     .conserves_angular_momentum = 1,
     .setup = ul_csph_setup,
     .stable_dt = ul_csph_stable_dt,
