@@ -14,6 +14,7 @@
 #include "methods/tl_iact.h"
 #include "sph/corrections.h"
 #include "sph/tensor.h"
+#include "terms/terms_impl.h"
 
 /* ---- mirror images
  * ------------------------------------------------------------ */
@@ -694,4 +695,72 @@ void tl_acceleration(sph_sim *sim, const tl_reference *ref, const double *dp) {
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
       acc[3 * a + c] = dp[3 * a + c] / ref->rho0[a];
+}
+
+sph_status tl_leapfrog_options(sph_node *opt, double *cfl, sph_error *err) {
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, cfl, err));
+  if (!(*cfl > 0.0 && *cfl <= 1.0))
+    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
+                          "cfl must be in (0, 1], got %g", *cfl);
+  const char *integ;
+  SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
+  if (strcmp(integ, "leapfrog"))
+    return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
+                          "'%s' is not one of: leapfrog", integ);
+  return SPH_OK;
+}
+
+sph_status
+tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
+                   double *dp,
+                   sph_status (*rates)(void *ctx, double t, sph_error *err),
+                   sph_status (*constrain)(void *ctx, double t, sph_error *err),
+                   void *ctx, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  *lf = (sph_leapfrog){.n = ref->n,
+                       .x = ref->x,
+                       .p = ref->p,
+                       .dp = dp,
+                       .rho0 = ref->rho0,
+                       .rates = rates,
+                       .constrain = constrain,
+                       .ctx = ctx};
+  if (s->has_body_force)
+    SPH_TRY(body_force_create(sim, ref->rho0, err));
+  if (sph_scene_has_essential_bc(s)) {
+    SPH_TRY(essential_bc_create(sim, ref->rho0, err));
+    SPH_TRY(constrain(ctx, 0.0, err));
+  }
+  return SPH_OK;
+}
+
+sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
+                              sph_leapfrog *lf, const double *dp,
+                              sph_error *err) {
+  tl_derive(sim, ref, NULL, NULL);
+  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
+    if (!lf->have_rates)
+      SPH_TRY(lf->rates(lf->ctx, sim->t, err));
+    tl_acceleration(sim, ref, dp);
+  }
+  return SPH_OK;
+}
+
+sph_status tl_rates_terms(sph_sim *sim, const tl_reference *ref, double *dp,
+                          int timer, double t0, double t, sph_error *err) {
+  sim->timers[timer].seconds += sph_wtime() - t0;
+  sim->timers[timer].calls++;
+  sph_stage s = {.t = t,
+                 .x = ref->x,
+                 .p = ref->p,
+                 .F = ref->F,
+                 .x_moment = ref->x,
+                 .dp = dp};
+  return sph_sim_terms_rates(sim, &s, err);
+}
+
+sph_status tl_constrain_terms(sph_sim *sim, const tl_reference *ref, double t,
+                              sph_error *err) {
+  sph_stage s = {.t = t, .x = ref->x, .p = ref->p, .F = ref->F};
+  return sph_sim_terms_constrain(sim, &s, err);
 }

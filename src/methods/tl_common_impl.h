@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "integrators/integrator_impl.h"
 #include "methods/tl_iact.h"
 #include "sph/material.h"
 #include "sph/neighbors.h"
@@ -143,6 +144,35 @@ sph_status tl_check_finite(const tl_reference *ref, sph_error *err);
 /* The acceleration output field, dp / rho0, from the rates of the current
  * state (only when the scene asks for it). */
 void tl_acceleration(sph_sim *sim, const tl_reference *ref, const double *dp);
+
+/* Adds the time since t0 to the method's force timer, then the terms'
+ * rates on the state of ref (x, p, F) into dp. */
+sph_status tl_rates_terms(sph_sim *sim, const tl_reference *ref, double *dp,
+                          int timer, double t0, double t, sph_error *err);
+
+/* The terms' constraints on the state of ref. */
+sph_status tl_constrain_terms(sph_sim *sim, const tl_reference *ref, double t,
+                              sph_error *err);
+
+/* The options of the leap-frog methods: `cfl` (default 0.3, in (0, 1])
+ * and `integrator: leapfrog`. */
+sph_status tl_leapfrog_options(sph_node *opt, double *cfl, sph_error *err);
+
+/* lf over the real particles of ref with the method's rates and
+ * constraints (ctx), the scene's body force and essential boundary
+ * conditions, the latter imposed at t = 0. */
+sph_status
+tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
+                   double *dp,
+                   sph_status (*rates)(void *ctx, double t, sph_error *err),
+                   sph_status (*constrain)(void *ctx, double t, sph_error *err),
+                   void *ctx, sph_error *err);
+
+/* tl_derive (J = det F) and, when the scene asks for it, the acceleration
+ * from the rates of the current state (computed if lf holds none). */
+sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
+                              sph_leapfrog *lf, const double *dp,
+                              sph_error *err);
 
 /* Kinetic and strain energy of the real particles; H and J may be NULL. */
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,

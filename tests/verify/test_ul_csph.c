@@ -3,20 +3,20 @@
  * vanishes on linear fields), the internal force as the exact gradient of
  * the discrete strain energy with the stabilised gradient (eq. 21 and its
  * adjoint), and the 1D bar and punch of sec. 3.3.1 and 4.3. */
+#include "test_scene_util.h"
 #include "test_util.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "sph/scene.h"
 #include "sph/sim.h"
 #include "sph/tensor.h"
 
 static sph_sim *make_sim(const char *method, int count, sph_scene **scene) {
-  char text[2048], path[64] = "/tmp/sph_ulcsph_XXXXXX";
+  char text[2048];
   snprintf(text, sizeof text,
            "name: ulcsph\ndimension: 3\nmethod: {name: ul-csph, %s}\n"
            "materials: {rubber: {model: neo-hookean, density: 1100, "
@@ -27,16 +27,10 @@ static sph_sim *make_sim(const char *method, int count, sph_scene **scene) {
            "time: {end: 1}\n"
            "output: {fields: [acceleration]}\n",
            method, count, count, count);
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  sph_error err;
-  sph_status st = sph_scene_load(scene, path, NULL, 0, &err);
-  unlink(path);
-  ck_assert_msg(st == SPH_OK, "%s", err.message);
+  *scene = sph_test_scene_text(text);
   sph_sim *sim = NULL;
-  st = sph_sim_create(&sim, *scene, &err);
+  sph_error err;
+  sph_status st = sph_sim_create(&sim, *scene, &err);
   ck_assert_msg(st == SPH_OK, "%s", err.message);
   return sim;
 }

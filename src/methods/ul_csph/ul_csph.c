@@ -123,17 +123,12 @@ static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
       m->dp[3 * a + c] *= m->Jr[a];
-  sim->timers[m->timer_force].seconds += sph_wtime() - t0;
-  sim->timers[m->timer_force].calls++;
-  sph_stage s = {
-      .t = t, .x = m->x, .p = m->p, .F = m->F, .x_moment = m->x, .dp = m->dp};
-  return sph_sim_terms_rates(sim, &s, err);
+  return tl_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status ul_csph_constrain(void *ctx, double t, sph_error *err) {
   ul_csph *m = ctx;
-  sph_stage s = {.t = t, .x = m->x, .p = m->p, .F = m->F};
-  return sph_sim_terms_constrain(m->sim, &s, err);
+  return tl_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 /* Per slot H~_k(x_a) h = H_k h + (A . (x_a - x_k)) h with the linear
@@ -256,13 +251,7 @@ static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
 static sph_status ul_csph_derive(sph_sim *sim, sph_error *err) {
   ul_csph *m = sim->method_data;
   deformation_and_stress(m, (long)sim->ps->n);
-  tl_derive(sim, &m->ref, NULL, NULL);
-  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
-    if (!m->lf.have_rates)
-      SPH_TRY(m->lf.rates(m->lf.ctx, sim->t, err));
-    tl_acceleration(sim, &m->ref, m->dp);
-  }
-  return SPH_OK;
+  return tl_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
 }
 
 static void ul_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
@@ -301,10 +290,7 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph");
   sim->method_data = m;
   m->sim = sim;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
-  if (!(m->cfl > 0.0 && m->cfl <= 1.0))
-    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
-                          "cfl must be in (0, 1], got %g", m->cfl);
+  SPH_TRY(tl_leapfrog_options(opt, &m->cfl, err));
   long every;
   SPH_TRY(sph_node_get_int(opt, "update_every", 0, 1, &every, err));
   if (every < 1 || every > 1000000000L)
@@ -318,11 +304,6 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (!(m->eta >= 0.0 && m->eta <= 100.0))
     return sph_node_error(sph_node_child(opt, "eta"), err, SPH_ERR_RANGE,
                           "eta must be in [0, 100], got %g", m->eta);
-  const char *integ;
-  SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
-  if (strcmp(integ, "leapfrog"))
-    return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
-                          "'%s' is not one of: leapfrog", integ);
   const sph_scene *s = sim->scene;
   SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
   sph_particles *ps = sim->ps;
@@ -352,21 +333,8 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (sim->initial_defgrad) /* the given deformed state is x^r */
     memcpy(m->ref.X, m->x, 3 * ne * sizeof *m->ref.X);
   SPH_TRY(rebuild(m, err));
-  m->lf = (sph_leapfrog){.n = ps->n,
-                         .x = m->x,
-                         .p = m->p,
-                         .dp = m->dp,
-                         .rho0 = m->ref.rho0,
-                         .rates = ul_csph_rates,
-                         .constrain = ul_csph_constrain,
-                         .ctx = m};
-  if (s->has_body_force)
-    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (sph_scene_has_essential_bc(s)) {
-    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
-    SPH_TRY(ul_csph_constrain(m, 0.0, err));
-  }
-  return SPH_OK;
+  return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,
+                            ul_csph_constrain, m, err);
 }
 
 static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
