@@ -162,6 +162,48 @@ START_TEST(force_is_energy_gradient) {
 }
 END_TEST
 
+/* update_distance: a reference update whenever a particle has moved that
+ * many spacings from x^r; on a rigid translation at 100 m/s that is every
+ * ceil(0.5 dp / (v dt)) steps, and F stays I */
+START_TEST(displacement_criterion) {
+  sph_scene *s;
+  sph_sim *sim = make_sim("update_distance: 0.5", 5, &s);
+  const sph_particles *ps = sim->ps;
+  sph_state_array arr[SPH_MAX_STATE];
+  int na = sim->method->state(sim, arr);
+  double *p = NULL;
+  for (int i = 0; i < na; ++i)
+    if (!strcmp(arr[i].name, "p"))
+      p = arr[i].data;
+  ck_assert_ptr_nonnull(p);
+  for (size_t a = 0; a < ps->n; ++a)
+    p[3 * a] = 100.0 * s->materials[0].density;
+  sph_error err;
+  double dt = sim->method->stable_dt(sim);
+  int steps = 30;
+  for (int i = 0; i < steps; ++i)
+    ck_assert_int_eq(sim->method->step(sim, dt, &err), SPH_OK);
+  unsigned long updates = 0;
+  for (int i = 0; i < sim->ntimers; ++i)
+    if (!strcmp(sim->timers[i].name, "reference_update"))
+      updates = sim->timers[i].calls;
+  int every = (int)ceil(0.5 * sim->dp / (100.0 * dt) + 1e-12);
+  /* the first update comes once the criterion holds, then one each `every`
+   * steps */
+  fprintf(stderr, "%lu updates in %d steps, every %d\n", updates, steps, every);
+  ck_assert_msg(updates > 1 &&
+                    labs((long)updates - (long)((steps - 1) / every)) <= 1,
+                "%lu updates in %d steps of %d each", updates, steps, every);
+  ck_assert_int_eq(sim->method->derive(sim, &err), SPH_OK);
+  for (size_t a = 0; a < ps->n; ++a)
+    for (int k = 0; k < 9; ++k)
+      ck_assert_double_eq_tol(ps->field[SPH_FIELD_DEFGRAD][9 * a + k],
+                              k % 4 == 0, 1e-12);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("ul_csph");
   TCase *tc = tcase_create("ul_csph");
@@ -169,6 +211,7 @@ int main(void) {
   tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
   tcase_add_test(tc, patch_test_after_updates);
   tcase_add_test(tc, force_is_energy_gradient);
+  tcase_add_test(tc, displacement_criterion);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }

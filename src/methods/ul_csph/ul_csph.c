@@ -239,9 +239,26 @@ static double ul_csph_stable_dt(sph_sim *sim) {
   return tl_stable_dt(&m->ref, sim, m->cfl, 1);
 }
 
+/* the displacement criterion: some particle has moved more than
+ * update_distance spacings from its reference position */
+static int moved_beyond(const ul_csph *m) {
+  const tl_reference *ref = &m->ref;
+  long n = (long)ref->n;
+  double lim = m->update_distance * m->sim->dp, d2max = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : d2max)
+  for (long a = 0; a < n; ++a) {
+    double d[3];
+    for (int c = 0; c < 3; ++c)
+      d[c] = m->x[3 * a + c] - ref->X[3 * a + c];
+    double d2 = sph_vec3_dot(d, d);
+    d2max = d2 > d2max ? d2 : d2max;
+  }
+  return d2max > lim * lim;
+}
+
 static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
   ul_csph *m = sim->method_data;
-  if (m->since >= m->update_every)
+  if (m->update_distance > 0.0 ? moved_beyond(m) : m->since >= m->update_every)
     SPH_TRY(reference_update(m, err));
   SPH_TRY(sph_leapfrog_step(&m->lf, sim->t, dt, err));
   m->since += 1.0;
@@ -282,8 +299,9 @@ static void ul_csph_destroy(sph_sim *sim) {
 }
 
 static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
-  static const char *const keys[] = {"name",         "cfl", "integrator",
-                                     "update_every", "eta", NULL};
+  static const char *const keys[] = {
+      "name", "cfl", "integrator", "update_every", "update_distance",
+      "eta",  NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   ul_csph *m = calloc(1, sizeof *m);
   if (!m)
@@ -291,6 +309,7 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   sim->method_data = m;
   m->sim = sim;
   SPH_TRY(tl_leapfrog_options(opt, &m->cfl, err));
+  int by_steps = sph_node_child(opt, "update_every") != NULL;
   long every;
   SPH_TRY(sph_node_get_int(opt, "update_every", 0, 1, &every, err));
   if (every < 1 || every > 1000000000L)
@@ -300,6 +319,16 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "%ld",
                           every);
   m->update_every = (int)every;
+  SPH_TRY(sph_node_get_double(opt, "update_distance", 0, 0.0,
+                              &m->update_distance, err));
+  if (!(m->update_distance >= 0.0 && m->update_distance <= 1e6))
+    return sph_node_error(
+        sph_node_child(opt, "update_distance"), err, SPH_ERR_RANGE,
+        "update_distance must be >= 0 spacings, got %g", m->update_distance);
+  if (by_steps && m->update_distance > 0.0)
+    return sph_node_error(sph_node_child(opt, "update_distance"), err,
+                          SPH_ERR_RANGE,
+                          "give update_every or update_distance, not both");
   SPH_TRY(sph_node_get_double(opt, "eta", 0, 0.3, &m->eta, err));
   if (!(m->eta >= 0.0 && m->eta <= 100.0))
     return sph_node_error(sph_node_child(opt, "eta"), err, SPH_ERR_RANGE,

@@ -8,10 +8,11 @@
 typedef struct ul_csph {
   tl_reference ref; /* X, V, nl, L, w of the current reference x^r */
   double cfl;
-  int update_every; /* steps between reference updates */
-  double since;     /* steps since the last update (a state array) */
-  double *V0;       /* initial volumes (n_ext) */
-  double *Fr, *Jr;  /* F^r and det F^r per point (9 n_ext, n_ext) */
+  int update_every;       /* steps between reference updates */
+  double update_distance; /* or when a particle has moved this many dp */
+  double since;           /* steps since the last update (a state array) */
+  double *V0;             /* initial volumes (n_ext) */
+  double *Fr, *Jr;        /* F^r and det F^r per point (9 n_ext, n_ext) */
   /* Hessian-difference stabilisation (sec. 3.4): eta and the vector h of
    * Remark 2; per slot H~_k(x_a) h, g_k(x_a).h and the reverse slot, per
    * point their sums over the slots (sum_k V_k H~_k h, sum_k g_k.h) */
