@@ -5,6 +5,7 @@ static const sph_method_ops *const methods[] = {
     &tl_jst_method_ops,
     &tl_csph_method_ops,
     &ul_sph_method_ops,
+    &ul_csph_method_ops,
     NULL,
 };
 

@@ -9,5 +9,6 @@
 extern const sph_method_ops tl_jst_method_ops;
 extern const sph_method_ops tl_csph_method_ops;
 extern const sph_method_ops ul_sph_method_ops;
+extern const sph_method_ops ul_csph_method_ops;
 
 #endif

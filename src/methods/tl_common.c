@@ -14,6 +14,7 @@
 #include "methods/tl_iact.h"
 #include "sph/corrections.h"
 #include "sph/tensor.h"
+#include "terms/terms_impl.h"
 
 /* ---- mirror images
  * ------------------------------------------------------------ */
@@ -244,6 +245,18 @@ sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **out,
   size_t *rev = malloc((nl->count ? nl->count : 1) * sizeof *rev);
   if (!rev)
     return sph_error_set(err, SPH_ERR_NOMEM, "reverse slots");
+  sph_status st = tl_reference_reverse_fill(ref, rev, err);
+  if (st != SPH_OK) {
+    free(rev);
+    return st;
+  }
+  *out = rev;
+  return SPH_OK;
+}
+
+sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
+                                     sph_error *err) {
+  const sph_neighbors *nl = ref->nl;
   long n = (long)nl->n, missing = 0;
 #pragma omp parallel for schedule(static) reduction(+ : missing)
   for (long a = 0; a < n; ++a)
@@ -262,11 +275,8 @@ sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **out,
       else
         ++missing;
     }
-  if (missing) {
-    free(rev);
+  if (missing)
     return sph_error_set(err, SPH_ERR_ARG, "neighbour lists are not symmetric");
-  }
-  *out = rev;
   return SPH_OK;
 }
 
@@ -319,6 +329,35 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
                               double **out, sph_error *err) {
   *out = calloc(ncomp * ref->n_ext + 1, sizeof **out);
   return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
+}
+
+sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+                                sph_error *err) {
+  const sph_scene *s = sim->scene;
+  size_t ne = ref->n_ext;
+  /* neighbours and corrected gradients in the reference configuration */
+  SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
+                              sim->kernel.support, ref->body,
+                              SPH_PAIRS_SAME_BODY, err));
+  if (ref->nl->count + 1 > ref->w_cap) { /* grows only, amortised */
+    size_t cap = 2 * (ref->nl->count + 1);
+    double *w = realloc(ref->w, cap * sizeof *w);
+    if (!w)
+      return sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
+    ref->w = w;
+    ref->w_cap = cap;
+  }
+  sph_cloud cloud = {.n = ne,
+                     .dim = s->dimension,
+                     .x = ref->X,
+                     .volume = ref->V,
+                     .id = ref->id,
+                     .nl = ref->nl,
+                     .kernel = &sim->kernel};
+  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL,
+                                  ref->L, err));
+  pair_weights(ref, &sim->kernel);
+  return SPH_OK;
 }
 
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
@@ -400,38 +439,19 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   }
   tl_mirror_refresh(ref, ref->x, ref->p, ref->F, NULL, ref->J);
 
-  /* neighbours and corrected gradients in the reference configuration */
-  SPH_TRY(sph_neighbors_create(&ref->nl, err));
-  SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
-                              sim->kernel.support, ref->body,
-                              SPH_PAIRS_SAME_BODY, err));
   int64_t *id = malloc(ne * sizeof *id);
   if (!id)
     return sph_error_set(err, SPH_ERR_NOMEM, "ids");
   for (size_t a = 0; a < ne; ++a)
     id[a] = ps->id[ref->src[a]];
-  sph_cloud cloud = {.n = ne,
-                     .dim = s->dimension,
-                     .x = ref->X,
-                     .volume = ref->V,
-                     .id = id,
-                     .nl = ref->nl,
-                     .kernel = &sim->kernel};
-  ref->w = malloc((ref->nl->count + 1) * sizeof *ref->w);
+  ref->id = id;
   ref->s = calloc(3 * n + 3, sizeof *ref->s);
-  sph_status st = SPH_OK;
-  if (!ref->w || !ref->s)
-    st = sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
-  if (st == SPH_OK)
-    st = tl_reference_alloc(ref, 9, &ref->L, err);
-  if (st == SPH_OK)
-    st = tl_reference_alloc(ref, 9, &ref->Qt, err);
-  if (st == SPH_OK)
-    st = sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL, ref->L,
-                                 err);
-  if (st == SPH_OK)
-    pair_weights(ref, &sim->kernel);
-  free(id);
+  if (!ref->s)
+    return sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
+  SPH_TRY(tl_reference_alloc(ref, 9, &ref->L, err));
+  SPH_TRY(tl_reference_alloc(ref, 9, &ref->Qt, err));
+  SPH_TRY(sph_neighbors_create(&ref->nl, err));
+  sph_status st = tl_reference_rebuild(ref, sim, err);
   sim->timers[timer].seconds += sph_wtime() - t0;
   sim->timers[timer].calls++;
   return st;
@@ -439,6 +459,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
 
 void tl_reference_destroy(tl_reference *ref) {
   sph_neighbors_destroy(ref->nl);
+  free(ref->id);
   free(ref->w);
   free(ref->L);
   free(ref->s);
@@ -674,4 +695,85 @@ void tl_acceleration(sph_sim *sim, const tl_reference *ref, const double *dp) {
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
       acc[3 * a + c] = dp[3 * a + c] / ref->rho0[a];
+}
+
+sph_status tl_leapfrog_options(sph_node *opt, double *cfl, sph_error *err) {
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, cfl, err));
+  if (!(*cfl > 0.0 && *cfl <= 1.0))
+    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
+                          "cfl must be in (0, 1], got %g", *cfl);
+  const char *integ;
+  SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
+  if (strcmp(integ, "leapfrog"))
+    return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
+                          "'%s' is not one of: leapfrog", integ);
+  return SPH_OK;
+}
+
+sph_status
+tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
+                   double *dp,
+                   sph_status (*rates)(void *ctx, double t, sph_error *err),
+                   sph_status (*constrain)(void *ctx, double t, sph_error *err),
+                   void *ctx, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  *lf = (sph_leapfrog){.n = ref->n,
+                       .x = ref->x,
+                       .p = ref->p,
+                       .dp = dp,
+                       .rho0 = ref->rho0,
+                       .rates = rates,
+                       .constrain = constrain,
+                       .ctx = ctx};
+  if (s->has_body_force)
+    SPH_TRY(body_force_create(sim, ref->rho0, err));
+  if (sph_scene_has_essential_bc(s)) {
+    SPH_TRY(essential_bc_create(sim, ref->rho0, err));
+    SPH_TRY(constrain(ctx, 0.0, err));
+  }
+  return SPH_OK;
+}
+
+sph_status tl_leapfrog_step(sph_sim *sim, const tl_reference *ref,
+                            sph_leapfrog *lf, int timer, double dt,
+                            sph_error *err) {
+  double s0 = lf->seconds;
+  SPH_TRY(sph_leapfrog_step(lf, sim->t, dt, err));
+  double t0 = sph_wtime();
+  sph_status st = tl_check_finite(ref, err);
+  sph_timer *tm = &sim->timers[timer];
+  tm->seconds += lf->seconds - s0 + sph_wtime() - t0;
+  tm->calls++;
+  return st;
+}
+
+sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
+                              sph_leapfrog *lf, const double *dp,
+                              sph_error *err) {
+  tl_derive(sim, ref, NULL, NULL);
+  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
+    if (!lf->have_rates)
+      SPH_TRY(lf->rates(lf->ctx, sim->t, err));
+    tl_acceleration(sim, ref, dp);
+  }
+  return SPH_OK;
+}
+
+sph_status tl_rates_terms(sph_sim *sim, const tl_reference *ref, double *dp,
+                          int timer, double t0, double t, sph_error *err) {
+  sim->timers[timer].seconds += sph_wtime() - t0;
+  sim->timers[timer].calls++;
+  sph_stage s = {.t = t,
+                 .x = ref->x,
+                 .p = ref->p,
+                 .F = ref->F,
+                 .x_moment = ref->x,
+                 .dp = dp};
+  return sph_sim_terms_rates(sim, &s, err);
+}
+
+sph_status tl_constrain_terms(sph_sim *sim, const tl_reference *ref, double t,
+                              sph_error *err) {
+  sph_stage s = {.t = t, .x = ref->x, .p = ref->p, .F = ref->F};
+  return sph_sim_terms_constrain(sim, &s, err);
 }

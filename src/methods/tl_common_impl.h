@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "integrators/integrator_impl.h"
 #include "methods/tl_iact.h"
 #include "sph/material.h"
 #include "sph/neighbors.h"
@@ -33,6 +34,8 @@ typedef struct tl_reference {
   int32_t *body;            /* bodies (n_ext) */
   sph_neighbors *nl;        /* over all n_ext points, same body only */
   double *w;                /* V_b W'(r_ab) / r_ab per slot */
+  size_t w_cap;             /* slots w holds */
+  int64_t *id;              /* particle id per point (n_ext) */
   double *L;                /* correction matrix per point (9 n_ext) */
   double *s;                /* sum_b w_ab r_ab per particle (3 n) */
   const sph_material **mat; /* per point (n_ext) */
@@ -62,10 +65,19 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                sph_error *err);
 void tl_reference_destroy(tl_reference *ref);
 
+/* Neighbour lists, correction matrices L, pair weights w and sums s from
+ * the current X and V (the updated-Lagrangian methods call it at each
+ * reference update; w grows only when the pair count exceeds it). */
+sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+                                sph_error *err);
+
 /* Slot of (b -> a) for every slot (a -> b), for pair quantities that are
  * not antisymmetric (allocated here, freed by the caller). */
 sph_status tl_reference_reverse_slots(const tl_reference *ref, size_t **rev,
                                       sph_error *err);
+/* The same into rev of at least nl->count entries. */
+sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
+                                     sph_error *err);
 
 /* Corrected gradient grad_b(X_a) of slot k of particle a (set-up use). */
 void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,
@@ -142,6 +154,40 @@ sph_status tl_check_finite(const tl_reference *ref, sph_error *err);
 /* The acceleration output field, dp / rho0, from the rates of the current
  * state (only when the scene asks for it). */
 void tl_acceleration(sph_sim *sim, const tl_reference *ref, const double *dp);
+
+/* Adds the time since t0 to the method's force timer, then the terms'
+ * rates on the state of ref (x, p, F) into dp. */
+sph_status tl_rates_terms(sph_sim *sim, const tl_reference *ref, double *dp,
+                          int timer, double t0, double t, sph_error *err);
+
+/* The terms' constraints on the state of ref. */
+sph_status tl_constrain_terms(sph_sim *sim, const tl_reference *ref, double t,
+                              sph_error *err);
+
+/* The options of the leap-frog methods: `cfl` (default 0.3, in (0, 1])
+ * and `integrator: leapfrog`. */
+sph_status tl_leapfrog_options(sph_node *opt, double *cfl, sph_error *err);
+
+/* lf over the real particles of ref with the method's rates and
+ * constraints (ctx), the scene's body force and essential boundary
+ * conditions, the latter imposed at t = 0. */
+sph_status
+tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
+                   double *dp,
+                   sph_status (*rates)(void *ctx, double t, sph_error *err),
+                   sph_status (*constrain)(void *ctx, double t, sph_error *err),
+                   void *ctx, sph_error *err);
+
+/* tl_derive (J = det F) and, when the scene asks for it, the acceleration
+ * from the rates of the current state (computed if lf holds none). */
+/* One leap-frog step and the finite-state check, their time added to the
+ * `timer` (time_integration). */
+sph_status tl_leapfrog_step(sph_sim *sim, const tl_reference *ref,
+                            sph_leapfrog *lf, int timer, double dt,
+                            sph_error *err);
+sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
+                              sph_leapfrog *lf, const double *dp,
+                              sph_error *err);
 
 /* Kinetic and strain energy of the real particles; H and J may be NULL. */
 void tl_energy(sph_sim *sim, const tl_reference *ref, const double *H,

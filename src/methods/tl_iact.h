@@ -99,6 +99,15 @@ static inline void tl_iact_gradient_correct(double G[9], const double L[9]) {
     G[k] = out[k];
 }
 
+/* Plane strain in 2D: the gradient of x has no z row or column but
+ * F_zz = 1 (the points all lie in one plane, so the sums leave it 0). */
+static inline void tl_iact_plane_strain(double F[9], int dim) {
+  if (dim == 2) {
+    F[2] = F[5] = F[6] = F[7] = 0.0;
+    F[8] = 1.0;
+  }
+}
+
 /* Globally conservative internal force of seed 000 eq. 29c / 42 (the
  * Galerkin force of seed 001 eq. 11 with the corrected gradient),
  * -T_a = sum_b V_b (P_a grad_b(X_a) - P_b grad_a(X_b))

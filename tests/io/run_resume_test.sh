@@ -67,6 +67,9 @@ kill_and_resume tl-jst twisting_column 0.3 0.02
 # (3.07 dp): resumed at 5 x 25 x 5, where it stays stable to 0.3 s
 kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}' \
   --set 'bodies.0.particles.count=[5,25,5]'
+# ul-csph: the reference x^r, F^r and the steps since the update are state;
+# neighbours, corrections and the stabilisation are rebuilt from them
+kill_and_resume ul-csph bending_cylinder_ul_csph 0.3 0.05
 # ul-sph: the configuration (neighbours, pair geometry) is rebuilt from the
 # checkpoint's positions of the last update
 kill_and_resume ul-sph colliding_rings 0.006 0.0005 \

@@ -18,6 +18,7 @@
 static void deformation_and_stress(tl_csph *m, long n) {
   tl_reference *ref = &m->ref;
   long ne = (long)ref->n_ext;
+  int dim = m->sim->scene->dimension;
   if (ne > n) /* image positions and momenta from their sources */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
@@ -27,6 +28,7 @@ static void deformation_and_stress(tl_csph *m, long n) {
     double F[9], unused[3];
     tl_sums_store(&s, F, unused);
     tl_iact_gradient_correct(F, ref->L + 9 * a);
+    tl_iact_plane_strain(F, dim);
     memcpy(m->F + 9 * a, F, sizeof F);
   }
   if (ne > n) /* the images' F mirror their sources' */
@@ -48,17 +50,12 @@ static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
   double t0 = sph_wtime();
   deformation_and_stress(m, n);
   tl_conservative_force(&m->ref, m->dp);
-  sim->timers[m->timer_force].seconds += sph_wtime() - t0;
-  sim->timers[m->timer_force].calls++;
-  sph_stage s = {
-      .t = t, .x = m->x, .p = m->p, .F = m->F, .x_moment = m->x, .dp = m->dp};
-  return sph_sim_terms_rates(sim, &s, err);
+  return tl_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status tl_csph_constrain(void *ctx, double t, sph_error *err) {
   tl_csph *m = ctx;
-  sph_stage s = {.t = t, .x = m->x, .p = m->p, .F = m->F};
-  return sph_sim_terms_constrain(m->sim, &s, err);
+  return tl_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 static double tl_csph_stable_dt(sph_sim *sim) {
@@ -68,26 +65,13 @@ static double tl_csph_stable_dt(sph_sim *sim) {
 
 static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
   tl_csph *m = sim->method_data;
-  double s0 = m->lf.seconds;
-  SPH_TRY(sph_leapfrog_step(&m->lf, sim->t, dt, err));
-  double t0 = sph_wtime();
-  sph_status st = tl_check_finite(&m->ref, err);
-  sph_timer *tm = &sim->timers[m->timer_integration];
-  tm->seconds += m->lf.seconds - s0 + sph_wtime() - t0;
-  tm->calls++;
-  return st;
+  return tl_leapfrog_step(sim, &m->ref, &m->lf, m->timer_integration, dt, err);
 }
 
 static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
   deformation_and_stress(m, (long)sim->ps->n);
-  tl_derive(sim, &m->ref, NULL, NULL);
-  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
-    if (!m->lf.have_rates)
-      SPH_TRY(m->lf.rates(m->lf.ctx, sim->t, err));
-    tl_acceleration(sim, &m->ref, m->dp);
-  }
-  return SPH_OK;
+  return tl_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
 }
 
 static void tl_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
@@ -114,22 +98,13 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph");
   sim->method_data = m;
   m->sim = sim;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
-  if (!(m->cfl > 0.0 && m->cfl <= 1.0))
-    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
-                          "cfl must be in (0, 1], got %g", m->cfl);
+  SPH_TRY(tl_leapfrog_options(opt, &m->cfl, err));
   const char *ws;
   SPH_TRY(sph_node_get_string(opt, "wave_speed", 0, "current", &ws, err));
   if (strcmp(ws, "current") && strcmp(ws, "reference"))
     return sph_node_error(sph_node_child(opt, "wave_speed"), err, SPH_ERR_RANGE,
                           "'%s' is not one of: current, reference", ws);
   m->current_wave_speed = !strcmp(ws, "current");
-  const char *integ;
-  SPH_TRY(sph_node_get_string(opt, "integrator", 0, "leapfrog", &integ, err));
-  if (strcmp(integ, "leapfrog"))
-    return sph_node_error(sph_node_child(opt, "integrator"), err, SPH_ERR_RANGE,
-                          "'%s' is not one of: leapfrog", integ);
-  const sph_scene *s = sim->scene;
   SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
   sph_particles *ps = sim->ps;
   m->x = m->ref.x;
@@ -141,21 +116,8 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph rates");
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");
-  m->lf = (sph_leapfrog){.n = ps->n,
-                         .x = m->x,
-                         .p = m->p,
-                         .dp = m->dp,
-                         .rho0 = m->ref.rho0,
-                         .rates = tl_csph_rates,
-                         .constrain = tl_csph_constrain,
-                         .ctx = m};
-  if (s->has_body_force)
-    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (sph_scene_has_essential_bc(s)) {
-    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
-    SPH_TRY(tl_csph_constrain(m, 0.0, err));
-  }
-  return SPH_OK;
+  return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, tl_csph_rates,
+                            tl_csph_constrain, m, err);
 }
 
 static int tl_csph_state(sph_sim *sim, sph_state_array *out) {

@@ -1,0 +1,30 @@
+/* Private state of the ul-csph method (seed 001 sec. 3-4). */
+#ifndef SPH_UL_CSPH_IMPL_H
+#define SPH_UL_CSPH_IMPL_H
+
+#include "integrators/integrator_impl.h"
+#include "methods/tl_common_impl.h"
+
+typedef struct ul_csph {
+  tl_reference ref; /* X, V, nl, L, w of the current reference x^r */
+  double cfl;
+  int update_every;       /* steps between reference updates */
+  double update_distance; /* or when a particle has moved this many dp */
+  double since;           /* steps since the last update (a state array) */
+  double *V0;             /* initial volumes (n_ext) */
+  double *Fr, *Jr;        /* F^r and det F^r per point (9 n_ext, n_ext) */
+  /* Hessian-difference stabilisation (sec. 3.4): eta and the vector h of
+   * Remark 2; per slot H~_k(x_a) h, g_k(x_a).h and the reverse slot, per
+   * point their sums over the slots (sum_k V_k H~_k h, sum_k g_k.h) */
+  double eta, h[3];
+  double *hv, *gh, *sv, *sgh;
+  size_t *rev, slot_cap;
+  double *f0, *S;        /* unstabilised f, P F^r^T / J^r (9 n_ext) */
+  double *x, *p, *F, *P; /* particle fields */
+  double *dp;            /* rate of momentum */
+  sph_leapfrog lf;
+  int timer_force, timer_update, timer_integration;
+  struct sph_sim *sim;
+} ul_csph;
+
+#endif
