@@ -25,6 +25,7 @@ static const char *const vertex_src =
     "layout(location = 0) in vec2 corner;\n"
     "layout(location = 1) in vec3 centre;\n"
     "layout(location = 2) in vec3 colour;\n"
+    "layout(location = 3) in float scale;\n"
     "uniform mat4 view;\n"
     "uniform mat4 proj;\n"
     "uniform float radius;\n"
@@ -33,20 +34,23 @@ static const char *const vertex_src =
     "uniform vec4 clip_plane;\n"
     "out vec3 v_colour;\n"
     "flat out vec3 v_centre;\n"
+    "flat out float v_radius;\n"
     "out vec3 v_pos;\n"
     "out vec2 v_quad;\n"
     "out float gl_ClipDistance[1];\n"
     "void main() {\n"
     "  vec3 c = (view * vec4(centre, 1.0)).xyz;\n"
+    "  float r = radius * scale;\n"
+    "  v_radius = r;\n"
     "  v_colour = colour;\n"
     "  v_centre = c;\n"
     "  v_quad = corner;\n"
     "  gl_ClipDistance[0] =\n"
     "      use_clip != 0 ? dot(clip_plane.xyz, centre) + clip_plane.w : 1.0;\n"
     "  if (ortho != 0) {\n"
-    "    v_pos = c + vec3(radius * corner, 0.0);\n"
+    "    v_pos = c + vec3(r * corner, 0.0);\n"
     "  } else {\n"
-    "    float d2 = dot(c, c), r2 = radius * radius;\n"
+    "    float d2 = dot(c, c), r2 = r * r;\n"
     "    if (d2 <= r2) {\n"
     "      v_pos = c;\n"
     "      gl_Position = vec4(0.0, 0.0, 2.0, 1.0);\n"
@@ -57,7 +61,7 @@ static const char *const vertex_src =
     "                                 : vec3(1.0, 0.0, 0.0);\n"
     "    vec3 s = normalize(cross(ref, axis));\n"
     "    vec3 t = cross(axis, s);\n"
-    "    float h = radius * sqrt(d2 / (d2 - r2));\n"
+    "    float h = r * sqrt(d2 / (d2 - r2));\n"
     "    v_pos = c + h * (corner.x * s + corner.y * t);\n"
     "  }\n"
     "  gl_Position = proj * vec4(v_pos, 1.0);\n"
@@ -70,10 +74,10 @@ static const char *const fragment_src =
     "#version 330 core\n"
     "in vec3 v_colour;\n"
     "flat in vec3 v_centre;\n"
+    "flat in float v_radius;\n"
     "in vec3 v_pos;\n"
     "in vec2 v_quad;\n"
     "uniform mat4 proj;\n"
-    "uniform float radius;\n"
     "uniform int ortho;\n"
     "uniform int flat_colour;\n"
     "out vec4 frag;\n"
@@ -84,13 +88,13 @@ static const char *const fragment_src =
     "    float q2 = dot(v_quad, v_quad);\n"
     "    if (q2 > 1.0) discard;\n"
     "    n = vec3(v_quad, sqrt(1.0 - q2));\n"
-    "    p = v_centre + radius * n;\n"
+    "    p = v_centre + v_radius * n;\n"
     "    to_eye = vec3(0.0, 0.0, 1.0);\n"
     "  } else {\n"
     "    vec3 dir = normalize(v_pos);\n"
     "    float b = dot(v_centre, dir);\n"
     "    vec3 off = v_centre - b * dir;\n"
-    "    float disc = radius * radius - dot(off, off);\n"
+    "    float disc = v_radius * v_radius - dot(off, off);\n"
     "    if (disc < 0.0) discard;\n"
     "    p = (b - sqrt(disc)) * dir;\n"
     "    n = normalize(p - v_centre);\n"
@@ -115,7 +119,7 @@ struct sph_gl {
   OSMesaContext ctx;
   unsigned char front[4]; /* 1x1 window buffer OSMesa needs; unused */
   int width, height;
-  GLuint program, vao, quad_vbo, centre_vbo, colour_vbo;
+  GLuint program, vao, quad_vbo, centre_vbo, colour_vbo, scale_vbo;
   GLuint fbo, colour_rb, depth_rb;
   GLint loc_view, loc_proj, loc_radius, loc_ortho, loc_use_clip, loc_plane;
   GLint loc_flat;
@@ -223,6 +227,12 @@ static void build_vertex_array(sph_gl *gl) {
   glEnableVertexAttribArray(2);
   glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_TRUE, 0, NULL);
   glVertexAttribDivisor(2, 1);
+  /* radius factors: 1 float per instance (a layer without them: 1) */
+  glGenBuffers(1, &gl->scale_vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+  glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0, NULL);
+  glVertexAttribDivisor(3, 1);
+  glVertexAttrib1f(3, 1.0f);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
@@ -349,6 +359,9 @@ static sph_status reserve(sph_gl *gl, size_t n, sph_error *err) {
                GL_DYNAMIC_DRAW);
   glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
   glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(cap * 3), NULL, GL_DYNAMIC_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+  glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(cap * sizeof(float)), NULL,
+               GL_DYNAMIC_DRAW);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
   SPH_TRY(gl_check("instance buffers", err));
   gl->capacity = cap;
@@ -421,6 +434,11 @@ static sph_status check_layer(const sph_gl_layer *l, sph_error *err) {
     for (int k = 0; k < 4; ++k)
       if (!isfinite(l->clip_plane[k]))
         return sph_error_set(err, SPH_ERR_ARG, "render: non-finite clip plane");
+  for (size_t i = 0; l->scale && i < l->n; ++i)
+    if (!(l->scale[i] > 0.0f && isfinite(l->scale[i])))
+      return sph_error_set(err, SPH_ERR_ARG,
+                           "render: sphere %zu has radius factor %g", i,
+                           (double)l->scale[i]);
   for (size_t i = 0; i < 3 * l->n; ++i)
     if (!isfinite(l->xyz[i]))
       return sph_error_set(err, SPH_ERR_NUMERIC,
@@ -467,9 +485,18 @@ sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
                     l->xyz);
     glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
     glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(l->n * 3), l->rgb);
+    glBindVertexArray(gl->vao);
+    if (l->scale) {
+      glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+      glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(l->n * sizeof(float)),
+                      l->scale);
+      glEnableVertexAttribArray(3);
+    } else {
+      glDisableVertexAttribArray(3);
+      glVertexAttrib1f(3, 1.0f);
+    }
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     set_uniforms(gl, view, l->radius, l->clip_plane, l->flat);
-    glBindVertexArray(gl->vao);
     glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)l->n);
     glBindVertexArray(0);
   }
@@ -489,7 +516,7 @@ sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
                                const unsigned char *rgb,
                                const double *clip_plane, sph_image *img,
                                sph_error *err) {
-  sph_gl_layer layer = {n, xyz, radius, rgb, clip_plane, 0};
+  sph_gl_layer layer = {n, xyz, radius, rgb, clip_plane, 0, NULL};
   return sph_gl_draw_layers(gl, view, &layer, 1, img, err);
 }
 
@@ -500,9 +527,10 @@ void sph_gl_destroy(sph_gl *gl) {
   if (gl->ctx && make_current(gl, NULL) == SPH_OK) {
     if (gl->program)
       glDeleteProgram(gl->program);
-    GLuint bufs[3] = {gl->quad_vbo, gl->centre_vbo, gl->colour_vbo};
+    GLuint bufs[4] = {gl->quad_vbo, gl->centre_vbo, gl->colour_vbo,
+                      gl->scale_vbo};
     GLuint rbs[2] = {gl->colour_rb, gl->depth_rb};
-    glDeleteBuffers(3, bufs);
+    glDeleteBuffers(4, bufs);
     glDeleteVertexArrays(1, &gl->vao);
     glDeleteFramebuffers(1, &gl->fbo);
     glDeleteRenderbuffers(2, rbs);

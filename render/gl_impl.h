@@ -112,6 +112,7 @@ typedef struct sph_gl_layer {
   const unsigned char *rgb;
   const double *clip_plane; /* NULL: no clip */
   int flat;                 /* 1: the colour unshaded (a flat silhouette) */
+  const float *scale;       /* per sphere factor on radius, or NULL (1) */
 } sph_gl_layer;
 
 /* Draws nlayers layers into one frame, in order: each layer is depth-tested

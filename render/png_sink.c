@@ -56,6 +56,7 @@
 /* One frame as the simulation thread hands it to the renderer. */
 typedef struct png_frame {
   float *xyz;    /* the kept particles' current positions, in index order */
+  float *scale;  /* their radius factors (J^(1/d)), or NULL without J */
   double *value; /* their colour values (NaN: none) */
   double lo, hi; /* colour range of this frame */
   int clamped_low, clamped_high;
@@ -80,6 +81,7 @@ typedef struct png_sink {
   unsigned char *keep; /* cut: the particles drawn */
   int follow;          /* refit the camera to the current bodies */
   int time_decimals;   /* of the time label: those of the output interval */
+  int dim;             /* 2 or 3: the sphere radius factor is J^(1/dim) */
   double fit_lo[3], fit_hi[3]; /* the box the camera frames */
   const sph_scene *scene;
   int field, ncomp;
@@ -441,9 +443,10 @@ static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
   const double *plane = p->clip ? p->plane : NULL;
   size_t ng = p->ghost ? m : 0;
   sph_gl_layer layers[3] = {
-      {ng, p->ghost_xyz, (float)(GHOST_RIM * dp), p->ghost_rim, plane, 1},
-      {ng, p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1},
-      {m, fr->xyz, (float)(0.5 * dp), p->rgb, plane, 0}};
+      {ng, p->ghost_xyz, (float)(GHOST_RIM * dp), p->ghost_rim, plane, 1, NULL},
+      {ng, p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1,
+       NULL},
+      {m, fr->xyz, (float)(0.5 * dp), p->rgb, plane, 0, fr->scale}};
   sph_error gerr;
   sph_status st =
       sph_gl_draw_layers(p->gl, &fr->view, layers, 3, &p->img, &gerr);
@@ -634,10 +637,13 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   p->rgb = malloc(3 * m);
   if (!p->rgb)
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  p->dim = sim->scene->dimension;
+  int with_j = sim->ps->field[SPH_FIELD_JACOBIAN] != NULL;
   for (int i = 0; i < 2; ++i) {
     p->slot[i].xyz = malloc(3 * m * sizeof *p->slot[i].xyz);
     p->slot[i].value = malloc(m * sizeof *p->slot[i].value);
-    if (!p->slot[i].xyz || !p->slot[i].value)
+    p->slot[i].scale = with_j ? malloc(m * sizeof *p->slot[i].scale) : NULL;
+    if (!p->slot[i].xyz || !p->slot[i].value || (with_j && !p->slot[i].scale))
       return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   }
   if (o->ghost) {
@@ -804,6 +810,7 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
                                sph_error *err) {
   const double *field = fr->ps->field[p->field];
   const double *x = fr->ps->field[SPH_FIELD_POSITION];
+  const double *J = fr->ps->field[SPH_FIELD_JACOBIAN];
   size_t n = fr->ps->n, m = 0;
   int nc = p->ncomp;
   double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
@@ -822,6 +829,12 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
       continue;
     for (int c = 0; c < 3; ++c)
       s->xyz[3 * m + c] = (float)x[3 * a + c];
+    if (s->scale && J) { /* the sphere of the particle's volume V0 J */
+      double f = p->dim == 3 ? cbrt(J[a]) : sqrt(fmax(J[a], 0.0));
+      s->scale[m] = (float)(f > 0.5 ? (f < 2.0 ? f : 2.0) : 0.5);
+    } else if (s->scale) {
+      s->scale[m] = 1.0f;
+    }
     s->value[m++] = v;
   }
   for (size_t i = 0; i < 3 * m; ++i)
@@ -915,6 +928,7 @@ static void png_destroy(sph_sink *sink) {
   for (int i = 0; i < 2; ++i) {
     free(p->slot[i].xyz);
     free(p->slot[i].value);
+    free(p->slot[i].scale);
   }
   free(p->ghost_xyz);
   free(p->ghost_rim);

@@ -203,6 +203,11 @@ static sph_status render_frames(render_job *j, int *frames, sph_error *err) {
       st = sph_vtp_read(path, ps->n, ps->field[SPH_FIELD_POSITION],
                         sph_field_name((sph_field)field), nc, ps->field[field],
                         &t, err);
+    /* J sizes the spheres as in the run (the sink's V0 J) */
+    if (st == SPH_OK && ps->field[SPH_FIELD_JACOBIAN] &&
+        field != SPH_FIELD_JACOBIAN)
+      st = sph_vtp_read(path, ps->n, ps->field[SPH_FIELD_POSITION], "J", 1,
+                        ps->field[SPH_FIELD_JACOBIAN], &t, err);
     sph_frame fr = {.time = isfinite(t) ? t : j->pvd.time[i],
                     .index = i,
                     .sim = &sim,
@@ -250,6 +255,19 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
     st = sph_particles_require(j.ps, SPH_FIELD_POSITION, err);
   if (st == SPH_OK)
     st = sph_particles_require(j.ps, (sph_field)field, err);
+  /* the files' J, when they hold it, sizes the spheres as the run did */
+  if (st == SPH_OK && j.pvd.count > 0) {
+    char path[1400];
+    double t;
+    sph_error jerr;
+    if (vtp_path(&j, 0, path, sizeof path, &jerr) == SPH_OK &&
+        sph_particles_require(j.ps, SPH_FIELD_JACOBIAN, &jerr) == SPH_OK &&
+        sph_vtp_read(path, j.ps->n, j.ps->field[SPH_FIELD_POSITION], "J", 1,
+                     j.ps->field[SPH_FIELD_JACOBIAN], &t, &jerr) != SPH_OK) {
+      free(j.ps->field[SPH_FIELD_JACOBIAN]);
+      j.ps->field[SPH_FIELD_JACOBIAN] = NULL;
+    }
+  }
   if (st == SPH_OK && a->range && !strcmp(a->range, "global"))
     st = global_range(&j, field, err);
   if (st == SPH_OK) {

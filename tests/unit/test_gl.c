@@ -120,6 +120,32 @@ START_TEST(one_sphere_ortho) {
 }
 END_TEST
 
+START_TEST(radius_factor_per_sphere) {
+  /* radius 0.25 with factor 2 (ortho, 100 px per unit) draws the 50 px
+   * disc of radius 0.5; factor 1 the 25 px one */
+  sph_gl *gl = context(200, 200);
+  sph_image img = image_new(200, 200);
+  sph_view v = front_view(1, 2.0, 5.0);
+  const float c[3] = {0, 0, 0}, c2[3] = {0.5f, 0.5f, 0.0f};
+  const unsigned char col[3] = {200, 60, 40};
+  const float two = 2.0f, one = 1.0f;
+  sph_gl_layer l = {1, c, 0.25f, col, NULL, 0, &two};
+  sph_error err;
+  ck_assert_int_eq(sph_gl_draw_layers(gl, &v, &l, 1, &img, &err), SPH_OK);
+  check_disc(&img, 100.0, 100.0, 50.0);
+  l.xyz = c2;
+  l.scale = &one;
+  ck_assert_int_eq(sph_gl_draw_layers(gl, &v, &l, 1, &img, &err), SPH_OK);
+  check_disc(&img, 150.0, 50.0, 25.0);
+  /* a factor that is not positive is refused */
+  const float zero = 0.0f;
+  l.scale = &zero;
+  ck_assert_int_eq(sph_gl_draw_layers(gl, &v, &l, 1, &img, &err), SPH_ERR_ARG);
+  sph_gl_destroy(gl);
+  free(img.rgba);
+}
+END_TEST
+
 START_TEST(one_sphere_perspective) {
   /* silhouette radius of a sphere on the axis: h/2 tan(asin(r/d)) / tan(fov/2)
    */
@@ -204,8 +230,8 @@ START_TEST(layers_paint_over) {
   sph_gl *gl = context(200, 200);
   sph_image img = image_new(200, 200);
   sph_view v = front_view(1, 2.0, 5.0);
-  sph_gl_layer layers[2] = {{1, grey_c, 0.5f, grey, NULL, 1},
-                            {1, red_c, 0.5f, red, NULL, 0}};
+  sph_gl_layer layers[2] = {{1, grey_c, 0.5f, grey, NULL, 1, NULL},
+                            {1, red_c, 0.5f, red, NULL, 0, NULL}};
   sph_error err;
   ck_assert_int_eq(sph_gl_draw_layers(gl, &v, layers, 2, &img, &err), SPH_OK);
   int red_px = 0;
@@ -438,6 +464,7 @@ int main(void) {
   TCase *tc = tcase_create("gl");
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, one_sphere_ortho);
+  tcase_add_test(tc, radius_factor_per_sphere);
   tcase_add_test(tc, one_sphere_perspective);
   tcase_add_test(tc, large_sphere);
   tcase_add_test(tc, occlusion_any_order);
