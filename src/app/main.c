@@ -59,9 +59,31 @@ static void usage(FILE *out) {
           "failure.\n");
 }
 
+/* The shipped scenes: $SPH_SCENES_DIR, else the installed copy beside the
+ * binary (<prefix>/bin/sph -> <prefix>/share/sph/scenes), else the source
+ * tree's. */
 const char *sph_app_scenes_dir(void) {
   const char *env = getenv("SPH_SCENES_DIR");
-  return env && *env ? env : SPH_SOURCE_DIR "/scenes";
+  if (env && *env)
+    return env;
+  static char installed[1200];
+  if (!installed[0]) {
+    char exe[1024];
+    ssize_t k = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    struct stat st;
+    installed[0] = '-'; /* looked, not found */
+    if (k > 0) {
+      exe[k] = '\0';
+      char *slash = strrchr(exe, '/');
+      if (slash) {
+        *slash = '\0';
+        snprintf(installed, sizeof installed, "%s/../share/sph/scenes", exe);
+        if (stat(installed, &st) != 0 || !S_ISDIR(st.st_mode))
+          snprintf(installed, sizeof installed, "-");
+      }
+    }
+  }
+  return installed[0] != '-' ? installed : SPH_SOURCE_DIR "/scenes";
 }
 
 const char *sph_app_default_scene(void) {
