@@ -172,6 +172,7 @@ typedef struct sph_output {
   double every;
   int vtk;
   int vtk_ascii;
+  int vtk_zlib; /* appended data compressed (vtkZLibDataCompressor) */
   int fields[SPH_FIELD_COUNT]; /* sph_field list for the sinks */
   int nfields;
   int body_id, particle_id; /* integer arrays asked for by name */

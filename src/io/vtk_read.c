@@ -1,13 +1,16 @@
 /* Reads back the VTK sink's files (include/sph/vtk_read.h): the .pvd
  * collection and, from a .vtp, the points and one Float64 point array, for
  * `sph render`. The whole file is read into memory; the XML header is
- * scanned for the DataArray tags this writer emits. */
+ * scanned for the DataArray tags this writer emits. Appended data may be
+ * raw or zlib-compressed (VTK's block header: count, block size, last
+ * block size, compressed sizes). */
 #include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "sph/vtk_read.h"
 
@@ -118,10 +121,39 @@ void sph_pvd_destroy(sph_pvd *pvd) {
   memset(pvd, 0, sizeof *pvd);
 }
 
+/* A zlib-compressed appended block at p (end: the file's end) into out,
+ * which holds want bytes. */
+static sph_status inflate_block(const char *path, const unsigned char *p,
+                                const unsigned char *end, unsigned char *out,
+                                size_t want, sph_error *err) {
+  uint64_t head[3];
+  if ((size_t)(end - p) < sizeof head)
+    return damaged(path, err, "a compressed block's header is cut short");
+  memcpy(head, p, sizeof head);
+  uint64_t nb = head[0], bs = head[1], last = head[2];
+  if (nb > (uint64_t)(end - p) / 8)
+    return damaged(path, err, "a compressed block's header is cut short");
+  const unsigned char *z = p + 24 + 8 * nb;
+  size_t got = 0;
+  for (uint64_t b = 0; b < nb; ++b) {
+    uint64_t cs;
+    memcpy(&cs, p + 24 + 8 * b, 8);
+    uLongf len = (uLongf)(b + 1 == nb && last ? last : bs);
+    if (cs > (uint64_t)(end - z) || got + len > want ||
+        uncompress(out + got, &len, z, (uLong)cs) != Z_OK)
+      return damaged(path, err, "a compressed block does not inflate");
+    got += len;
+    z += cs;
+  }
+  if (got != want)
+    return damaged(path, err, "a compressed array has the wrong length");
+  return SPH_OK;
+}
+
 /* One DataArray of the header: copies its doubles into out. */
 static sph_status read_array(const char *path, const char *data, size_t size,
-                             const char *tag, const char *base, size_t count,
-                             double *out, sph_error *err) {
+                             const char *tag, const char *base, int zlib,
+                             size_t count, double *out, sph_error *err) {
   const char *end = strchr(tag, '>');
   char type[16], format[16], offset[32];
   if (!end || !attribute(tag, end, "type", type, sizeof type) ||
@@ -145,6 +177,13 @@ static sph_status read_array(const char *path, const char *data, size_t size,
     return damaged(path, err, "an appended array without its data");
   unsigned long long off = strtoull(offset, NULL, 10);
   size_t at = (size_t)(base - data);
+  if (zlib)
+    return off > size - at
+               ? damaged(path, err, "an array's offset lies beyond the file")
+               : inflate_block(path, (const unsigned char *)base + off,
+                               (const unsigned char *)data + size,
+                               (unsigned char *)out, count * sizeof(double),
+                               err);
   uint64_t bytes;
   if (off > size || at + off + sizeof bytes > size)
     return damaged(path, err, "an array's offset lies beyond the file");
@@ -166,6 +205,8 @@ sph_status sph_vtp_read(const char *path, size_t n, double *points,
   const char *appended = strstr(data, "<AppendedData");
   const char *base = appended ? strchr(appended, '_') : NULL;
   const char *head_end = appended ? appended : data + strlen(data);
+  int zlib = strstr(data, "compressor=\"vtkZLibDataCompressor\"") != NULL &&
+             strstr(data, "compressor=") < piece;
   char count[32];
   if (!strstr(data, "<VTKFile type=\"PolyData\"") || !piece ||
       !attribute(piece, strchr(piece, '>'), "NumberOfPoints", count,
@@ -189,7 +230,7 @@ sph_status sph_vtp_read(const char *path, size_t n, double *points,
   if (st == SPH_OK && (!tag || tag > head_end))
     st = damaged(path, err, "no points");
   if (st == SPH_OK)
-    st = read_array(path, data, size, tag, base, 3 * n, points, err);
+    st = read_array(path, data, size, tag, base, zlib, 3 * n, points, err);
   if (st == SPH_OK && name) {
     char names[512] = "";
     const char *found = NULL;
@@ -218,8 +259,8 @@ sph_status sph_vtp_read(const char *path, size_t n, double *points,
                         "point array '%s' does not have %d components", name,
                         ncomp);
     else
-      st = read_array(path, data, size, found, base, (size_t)ncomp * n, values,
-                      err);
+      st = read_array(path, data, size, found, base, zlib, (size_t)ncomp * n,
+                      values, err);
   }
   free(data);
   return st;

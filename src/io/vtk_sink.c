@@ -6,11 +6,16 @@
  * rewritten after each frame so a running or killed simulation always
  * loads in ParaView. Every file is written to a temporary name, fsync'd
  * and renamed. Particles are listed in creation order whatever their
- * storage order (sph_particles_sort_morton). */
+ * storage order (sph_particles_sort_morton). With output.vtk.compress: zlib
+ * each appended array is one zlib block behind VTK's compression header
+ * (vtkZLibDataCompressor, UInt64 words: 1 block, its size, 0, the
+ * compressed size); the blocks are compressed first, since the XML header
+ * gives their offsets. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "sph/sink.h"
 
@@ -22,6 +27,13 @@ typedef struct vtk_sink {
   int nframes, cap;
   int64_t *ids; /* connectivity / offsets work array */
   size_t n;
+  /* zlib: one array's bytes in creation order, the compressed blocks of a
+   * frame, and each block's place and size in them */
+  int zlib;
+  unsigned char *raw, *pool;
+  size_t pool_cap;
+  size_t zat[SPH_FIELD_COUNT + 4];
+  uint64_t zsize[SPH_FIELD_COUNT + 4], zraw[SPH_FIELD_COUNT + 4];
 } vtk_sink;
 
 typedef struct array_desc {
@@ -58,6 +70,21 @@ static sph_status vtk_open(sph_sink *sink, const sph_sim *sim, const char *dir,
   v->ids = malloc((v->n ? v->n : 1) * sizeof *v->ids);
   if (!v->times || !v->ids)
     return sph_error_set(err, SPH_ERR_NOMEM, "vtk sink");
+  v->zlib = sim->scene->output.vtk_zlib;
+  if (v->zlib) { /* room for every array of a frame, compressed */
+    const sph_output *o = &sim->scene->output;
+    size_t nn = v->n ? v->n : 1, total = nn * (3 + 2 + 1) * 8, widest = 3;
+    for (int i = 0; i < o->nfields; ++i) {
+      int nc = sph_field_components((sph_field)o->fields[i]);
+      total += nn * (size_t)nc * 8;
+      widest = (size_t)nc > widest ? (size_t)nc : widest;
+    }
+    v->pool_cap = compressBound((uLong)total) + 64 * (SPH_FIELD_COUNT + 4);
+    v->raw = malloc(nn * widest * 8);
+    v->pool = malloc(v->pool_cap);
+    if (!v->raw || !v->pool)
+      return sph_error_set(err, SPH_ERR_NOMEM, "vtk sink (zlib)");
+  }
   /* resuming: the frames before the checkpoint are on disk */
   for (int i = 0; i < sink->resume_frames && i < v->cap; ++i)
     v->times[v->nframes++] = sph_output_time(sim->scene, i);
@@ -99,8 +126,16 @@ static void write_ascii(FILE *f, const array_desc *a, size_t n) {
   }
 }
 
+/* the appended bytes of block k: its header words and data */
+static uint64_t block_bytes(const vtk_sink *v, int k, const array_desc *a,
+                            size_t n) {
+  if (!v->zlib)
+    return 8 + n * (size_t)a->ncomp * type_size(a->type);
+  return v->zraw[k] ? 4 * 8 + v->zsize[k] : 3 * 8;
+}
+
 static void data_array(FILE *f, const vtk_sink *v, const array_desc *a,
-                       uint64_t *offset, size_t n) {
+                       uint64_t *offset, size_t n, int k) {
   fprintf(f,
           "        <DataArray type=\"%s\" Name=\"%s\" "
           "NumberOfComponents=\"%d\" format=\"%s\"",
@@ -111,7 +146,7 @@ static void data_array(FILE *f, const vtk_sink *v, const array_desc *a,
     fputs("        </DataArray>\n", f);
   } else {
     fprintf(f, " offset=\"%llu\"/>\n", (unsigned long long)*offset);
-    *offset += 8 + n * (size_t)a->ncomp * type_size(a->type);
+    *offset += block_bytes(v, k, a, n);
   }
 }
 
@@ -131,6 +166,32 @@ static void append_block(FILE *f, const array_desc *a, size_t n) {
       used = 0;
     }
   }
+}
+
+/* zlib: array a (creation order) compressed as block k into the pool */
+static sph_status zblock(vtk_sink *v, int k, const array_desc *a, size_t n,
+                         size_t *used, sph_error *err) {
+  size_t size = type_size(a->type), count = n * (size_t)a->ncomp;
+  for (size_t i = 0; i < count; ++i)
+    memcpy(v->raw + i * size, element(a, i, size), size);
+  uLongf len = (uLongf)(v->pool_cap - *used);
+  v->zraw[k] = count * size;
+  v->zat[k] = *used;
+  v->zsize[k] = 0;
+  if (!count)
+    return SPH_OK;
+  if (compress2(v->pool + *used, &len, v->raw, (uLong)(count * size), 1) !=
+      Z_OK)
+    return sph_error_set(err, SPH_ERR_NOMEM, "vtk sink: zlib failed");
+  v->zsize[k] = len;
+  *used += len;
+  return SPH_OK;
+}
+
+static void append_zblock(FILE *f, const vtk_sink *v, int k) {
+  uint64_t head[4] = {v->zraw[k] ? 1 : 0, v->zraw[k], 0, v->zsize[k]};
+  fwrite(head, 8, v->zraw[k] ? 4 : 3, f);
+  fwrite(v->pool + v->zat[k], 1, v->zsize[k], f);
 }
 
 static sph_status write_pvd(vtk_sink *v, sph_error *err) {
@@ -171,6 +232,19 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
   for (size_t i = 0; i < n; ++i)
     v->ids[i] = (int64_t)i; /* connectivity i, offsets i + 1 */
   array_desc conn = {"connectivity", "Int64", 1, v->ids, NULL};
+  /* zlib: blocks 0..na-1 the arrays, then points, connectivity, offsets */
+  if (v->zlib) {
+    size_t used = 0;
+    for (int i = 0; i < na; ++i)
+      SPH_TRY(zblock(v, i, &arrays[i], n, &used, err));
+    SPH_TRY(zblock(v, na, &points, n, &used, err));
+    SPH_TRY(zblock(v, na + 1, &conn, n, &used, err));
+    for (size_t i = 0; i < n; ++i)
+      v->ids[i] = (int64_t)i + 1;
+    SPH_TRY(zblock(v, na + 2, &conn, n, &used, err));
+    for (size_t i = 0; i < n; ++i)
+      v->ids[i] = (int64_t)i;
+  }
   sph_atomic_file af;
   SPH_TRY(sph_atomic_open(&af, path, err));
   FILE *f = af.f;
@@ -178,11 +252,11 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
   fprintf(f,
           "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" "
           "version=\"1.0\" byte_order=\"LittleEndian\" "
-          "header_type=\"UInt64\">\n  <PolyData>\n    <FieldData>\n"
+          "header_type=\"UInt64\"%s>\n  <PolyData>\n    <FieldData>\n"
           "      <DataArray type=\"Float64\" Name=\"TimeValue\" "
           "NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n"
           "    </FieldData>\n",
-          fr->time);
+          v->zlib ? " compressor=\"vtkZLibDataCompressor\"" : "", fr->time);
   fprintf(f,
           "    <Piece "
           "NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
@@ -191,11 +265,11 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
   uint64_t offset = 0;
   fputs("      <PointData>\n", f);
   for (int i = 0; i < na; ++i)
-    data_array(f, v, &arrays[i], &offset, n);
+    data_array(f, v, &arrays[i], &offset, n, i);
   fputs("      </PointData>\n      <Points>\n", f);
-  data_array(f, v, &points, &offset, n);
+  data_array(f, v, &points, &offset, n, na);
   fputs("      </Points>\n      <Verts>\n", f);
-  data_array(f, v, &conn, &offset, n);
+  data_array(f, v, &conn, &offset, n, na + 1);
   /* offsets: 1..n, written from the same work array shifted by one */
   uint64_t offsets_at = offset;
   if (v->ascii) {
@@ -212,7 +286,12 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
             (unsigned long long)offsets_at);
   }
   fputs("      </Verts>\n    </Piece>\n  </PolyData>\n", f);
-  if (!v->ascii) {
+  if (v->zlib) {
+    fputs("  <AppendedData encoding=\"raw\">\n   _", f);
+    for (int k = 0; k < na + 3; ++k)
+      append_zblock(f, v, k);
+    fputs("\n  </AppendedData>\n", f);
+  } else if (!v->ascii) {
     fputs("  <AppendedData encoding=\"raw\">\n   _", f);
     for (int i = 0; i < na; ++i)
       append_block(f, &arrays[i], n);
@@ -248,6 +327,8 @@ static void vtk_destroy(sph_sink *sink) {
     return;
   free(v->times);
   free(v->ids);
+  free(v->raw);
+  free(v->pool);
   free(v);
   sink->data = NULL;
 }

@@ -1006,14 +1006,22 @@ static sph_status parse_output(sph_scene *s, sph_node *root, sph_error *err) {
   o->vtk = 1;
   if (vtk && vtk->kind == SPH_NODE_MAP) {
     vtk->used = 1;
-    static const char *const vkeys[] = {"format", NULL};
+    static const char *const vkeys[] = {"format", "compress", NULL};
     SPH_TRY(sph_node_check_keys(vtk, vkeys, err));
-    const char *fmt;
+    const char *fmt, *zip;
     SPH_TRY(sph_node_get_string(vtk, "format", 0, "binary", &fmt, err));
     if (strcmp(fmt, "binary") && strcmp(fmt, "ascii"))
       return sph_node_error(sph_node_child(vtk, "format"), err, SPH_ERR_RANGE,
                             "format is binary or ascii, got '%s'", fmt);
     o->vtk_ascii = !strcmp(fmt, "ascii");
+    SPH_TRY(sph_node_get_string(vtk, "compress", 0, "none", &zip, err));
+    if (strcmp(zip, "none") && strcmp(zip, "zlib"))
+      return sph_node_error(sph_node_child(vtk, "compress"), err, SPH_ERR_RANGE,
+                            "compress is none or zlib, got '%s'", zip);
+    o->vtk_zlib = !strcmp(zip, "zlib");
+    if (o->vtk_zlib && o->vtk_ascii)
+      return sph_node_error(sph_node_child(vtk, "compress"), err, SPH_ERR_ARG,
+                            "compress: zlib applies to the binary format");
   } else {
     SPH_TRY(sph_node_get_bool(out, "vtk", 0, 1, &o->vtk, err));
   }
