@@ -18,5 +18,19 @@ cd "$work/elsewhere" || exit 1
 "$prefix/bin/sph" run punch --out run --quiet --set time.end=0.0004 \
   --set output.every=0.0002 --set output.png=false >/dev/null 2>&1 && [ -f run/summary.json ] && ok ||
   bad "installed run"
+# embedding: the installed library, headers and sph.pc build the example,
+# which steps an installed scene through the API and writes energy.csv
+ex=$work/embed
+PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name sph.pc | head -1)")"
+export PKG_CONFIG_PATH
+if cc "$prefix/share/sph/examples/embed.c" $(pkg-config --cflags --libs sph) -o "$ex" 2>"$work/cc.log"; then
+  ok
+  mkdir -p "$work/emb" && cd "$work/emb" || exit 1
+  "$ex" "$prefix/share/sph/scenes/punch.yaml" time.end=0.0004 output.every=0.0002 >"$work/emb.log" 2>&1 &&
+    grep -q "^done: " "$work/emb.log" && grep -q "max |u|" "$work/emb.log" &&
+    [ "$(wc -l <energy.csv)" -eq 4 ] && ok || bad "embed run: $(cat "$work/emb.log")"
+else
+  bad "embed does not build against sph.pc: $(cat "$work/cc.log")"
+fi
 echo "install: $pass passed, $fail failed"
 [ $fail -eq 0 ]
