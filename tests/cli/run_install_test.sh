@@ -32,5 +32,20 @@ if cc "$prefix/share/sph/examples/embed.c" $(pkg-config --cflags --libs sph) -o 
 else
   bad "embed does not build against sph.pc: $(cat "$work/cc.log")"
 fi
+# the CMake package: find_package(sph) and sph::sph build the same example
+mkdir -p "$work/cm"
+cat >"$work/cm/CMakeLists.txt" <<CM
+cmake_minimum_required(VERSION 3.20)
+project(embed C)
+find_package(sph REQUIRED)
+add_executable(embed $prefix/share/sph/examples/embed.c)
+target_link_libraries(embed PRIVATE sph::sph)
+CM
+if cmake -S "$work/cm" -B "$work/cm/build" -DCMAKE_PREFIX_PATH="$prefix" >"$work/cm.log" 2>&1 &&
+  cmake --build "$work/cm/build" >>"$work/cm.log" 2>&1 && [ -x "$work/cm/build/embed" ]; then
+  ok
+else
+  bad "find_package(sph): $(tail -5 "$work/cm.log")"
+fi
 echo "install: $pass passed, $fail failed"
 [ $fail -eq 0 ]
