@@ -1,6 +1,7 @@
 # Bash completion for sph. Commands, each command's options (read from
-# `sph help COMMAND`, so they follow the binary) and shipped scene names
-# (`sph list`). Install: source this file, or copy it to
+# `sph help COMMAND`, so they follow the binary), shipped scene names
+# (`sph list`) and, after --set or --vary, the scene's keys with every
+# default filled in (`sph check SCENE --keys`). Install: source this file, or copy it to
 # /usr/share/bash-completion/completions/sph.
 _sph() {
   local cur prev cmd
@@ -13,6 +14,23 @@ _sph() {
     return
   fi
   case "$prev" in
+  --set | --vary)
+    local scene=twisting_column i
+    for ((i = 2; i < COMP_CWORD; ++i)); do
+      case "${COMP_WORDS[i - 1]}" in
+      --set | --vary | --out | --resume | --threads | --repeat | --resolution | --json) continue ;;
+      esac
+      if [[ "${COMP_WORDS[i]}" != -* ]]; then
+        scene=${COMP_WORDS[i]}
+        break
+      fi
+    done
+    local keys
+    keys=$("$sph" check "$scene" --keys 2>/dev/null | sed 's/$/=/')
+    compopt -o nospace 2>/dev/null
+    COMPREPLY=($(compgen -W "$keys" -- "$cur"))
+    return
+    ;;
   --out | --resume | --json | --diff)
     COMPREPLY=($(compgen -f -- "$cur"))
     return

@@ -29,6 +29,7 @@ typedef struct sph_app_args {
   int threads;        /* --threads N (0 = OpenMP default) */
   int overwrite;      /* --overwrite */
   int quiet;          /* --quiet */
+  int keys;           /* check --keys */
 } sph_app_args;
 
 /* The options of every command (ids of options.c's shared table). */
@@ -56,7 +57,8 @@ enum {
   SPH_OPT_RANGE,
   SPH_OPT_WIDTH,
   SPH_OPT_HEIGHT,
-  SPH_OPT_MP4
+  SPH_OPT_MP4,
+  SPH_OPT_KEYS
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows

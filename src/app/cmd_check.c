@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include "app/app_impl.h"
+#include "sph/node.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
 
@@ -48,13 +49,29 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
          peak_rss_mib(), (double)sph_particles_bytes(ps) / 1048576.0);
 }
 
-static const int check_allowed[] = {SPH_OPT_SET, 0};
+static const int check_allowed[] = {SPH_OPT_SET, SPH_OPT_KEYS, 0};
 static const sph_app_command check_command = {
     "check",
-    "usage: sph check SCENE [--set key=value]...\n"
+    "usage: sph check SCENE [--set key=value]... [--keys]\n"
     "  validate SCENE (a file or a shipped scene's name) and print what a\n"
-    "  run would simulate: bodies, method, terms, time step, memory\n",
+    "  run would simulate: bodies, method, terms, time step, memory;\n"
+    "  --keys: every key the scene has, defaults filled in, as --set writes\n"
+    "  it (bodies.0.particles.count), one per line\n",
     check_allowed, NULL, NULL};
+
+/* --keys: the resolved tree's key paths in --set's form ([k] -> .k) */
+static void print_keys(const sph_node *n) {
+  if (n->path && n->path[0]) {
+    for (const char *c = n->path; *c; ++c)
+      if (*c == '[')
+        putchar('.');
+      else if (*c != ']')
+        putchar(*c);
+    putchar('\n');
+  }
+  for (size_t i = 0; i < n->count; ++i)
+    print_keys(n->items[i]);
+}
 
 int sph_cmd_check(int argc, char **argv) {
   sph_app_args args;
@@ -70,7 +87,10 @@ int sph_cmd_check(int argc, char **argv) {
   sph_sim *sim;
   if ((rc = sph_app_load(&args, args.scene, &scene, &sim)) != SPH_EXIT_OK)
     return rc;
-  print_plan(scene, sim);
+  if (args.keys)
+    print_keys(scene->root);
+  else
+    print_plan(scene, sim);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
   return SPH_EXIT_OK;

@@ -196,6 +196,9 @@ static int args_option(void *ctx, int id, const char *val) {
   case SPH_OPT_QUIET:
     args->quiet = 1;
     return SPH_EXIT_OK;
+  case SPH_OPT_KEYS:
+    args->keys = 1;
+    return SPH_EXIT_OK;
   default:
     return SPH_EXIT_USAGE;
   }

@@ -34,6 +34,7 @@ static const struct option all_options[] = {
     {"width", required_argument, NULL, SPH_OPT_WIDTH},
     {"height", required_argument, NULL, SPH_OPT_HEIGHT},
     {"mp4", no_argument, NULL, SPH_OPT_MP4},
+    {"keys", no_argument, NULL, SPH_OPT_KEYS},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 

@@ -23,6 +23,11 @@ complete_line "$sph" run --o | grep -qx -- --overwrite && ok || bad "run --overw
 complete_line "$sph" render --r | grep -qx -- --range && ok || bad "render --range"
 complete_line "$sph" run twist | grep -qx twisting_column && ok || bad "scene names: $(complete_line "$sph" run twist)"
 complete_line "$sph" check colliding_r | grep -qx colliding_rings && ok || bad "check scene"
+# --set keys of the scene given, defaults included
+complete_line "$sph" run punch --set method.c | grep -qx "method.cfl=" && ok ||
+  bad "--set keys: $(complete_line "$sph" run punch --set method.c)"
+complete_line "$sph" study colliding_rings --vary bodies.1.particles.sp | grep -qx "bodies.1.particles.spacing=" &&
+  ok || bad "--vary keys: $(complete_line "$sph" study colliding_rings --vary bodies.1.particles.sp)"
 
 man=$work/sph.1
 bash "$src/tools/gen_manpage.sh" "$sph" >"$man" || bad "gen_manpage.sh failed"
