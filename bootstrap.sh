@@ -13,6 +13,7 @@ packages=(
   libpng-dev        # PNG frames
   libosmesa6-dev    # off-screen OpenGL renderer
   libfreetype-dev fonts-dejavu-core  # text on frames
+  libfontconfig-dev # the frames' font found through fontconfig
   python3-vtk9      # VTK's own reader validates the files we write (tests)
   clang-format      # formatting is a test
   gnuplot-nox       # sph study figures (pngcairo)

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <fontconfig/fontconfig.h>
 #include <ft2build.h>
 #include FT_FREETYPE_H
 
@@ -17,12 +18,45 @@ struct sph_text {
   int px; /* pixel size currently set on the face, 0 = none */
 };
 
+/* The file fontconfig matches for DejaVu Sans (any sans-serif face when it
+ * is missing), into path; 0 when fontconfig finds none. */
+static int fontconfig_sans(char *path, size_t size) {
+  int found = 0;
+  FcConfig *cfg = FcInitLoadConfigAndFonts();
+  FcPattern *pat =
+      cfg ? FcNameParse((const FcChar8 *)"DejaVu Sans:style=Book") : NULL;
+  if (pat && FcConfigSubstitute(cfg, pat, FcMatchPattern)) {
+    FcDefaultSubstitute(pat);
+    FcResult res;
+    FcPattern *match = FcFontMatch(cfg, pat, &res);
+    FcChar8 *file = NULL;
+    if (match &&
+        FcPatternGetString(match, FC_FILE, 0, &file) == FcResultMatch &&
+        strlen((const char *)file) < size) {
+      strcpy(path, (const char *)file);
+      found = 1;
+    }
+    if (match)
+      FcPatternDestroy(match);
+  }
+  if (pat)
+    FcPatternDestroy(pat);
+  if (cfg)
+    FcConfigDestroy(cfg);
+  return found;
+}
+
 sph_status sph_text_create(const char *font_path, sph_text **out,
                            sph_error *err) {
   if (!out)
     return sph_error_set(err, SPH_ERR_ARG, "sph_text_create: no output");
   *out = NULL;
-  const char *path = font_path ? font_path : SPH_DEFAULT_FONT;
+  /* the font: as given, else fontconfig's DejaVu Sans, else the path of
+   * Debian's fonts-dejavu-core */
+  char found[1024];
+  const char *path = font_path                              ? font_path
+                     : fontconfig_sans(found, sizeof found) ? found
+                                                            : SPH_DEFAULT_FONT;
   sph_text *t = calloc(1, sizeof *t);
   if (!t)
     return sph_error_set(err, SPH_ERR_NOMEM, "no memory for the text object");
