@@ -346,3 +346,29 @@ void sph_overlay_label(sph_image *img, sph_text *t, int x, int y,
     sph_text_draw(t, img, x + pad, y + pad + asc + i * line_h, px, s, black);
   free(copy);
 }
+
+void sph_overlay_axes(sph_image *img, sph_text *t, int x, int y, int len,
+                      const double dir[3][2]) {
+  if (!img || !img->rgba || len <= 0)
+    return;
+  static const unsigned char rgb[3][3] = {
+      {200, 40, 40}, {40, 150, 40}, {40, 70, 200}};
+  static const char *const name[3] = {"X", "Y", "Z"};
+  int px = sph_overlay_font_px(img);
+  for (int k = 0; k < 3; ++k) {
+    double dx = dir[k][0], dy = dir[k][1];
+    double l = sqrt(dx * dx + dy * dy);
+    /* 2 px wide, drawn by samples along the segment */
+    int steps = (int)ceil(2.0 * len * l) + 1;
+    for (int i = 0; i <= steps; ++i) {
+      double f = (double)i / steps;
+      int cx = (int)floor(x + f * len * dx + 0.5);
+      int cy = (int)floor(y - f * len * dy + 0.5);
+      fill_rect(img, cx - 1, cy - 1, cx + 1, cy + 1, rgb[k]);
+    }
+    if (t && l > 0.2) /* a label where the axis is not seen end-on */
+      sph_text_draw(t, img, (int)(x + 1.15 * len * dx) - px / 4,
+                    (int)(y - 1.15 * len * dy) + px / 3, px * 3 / 4, name[k],
+                    rgb[k]);
+  }
+}

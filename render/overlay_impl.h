@@ -105,6 +105,11 @@ int sph_colorbar_extent(const sph_image *img, sph_text *t,
 
 /* Default text height for an image: height / 32, within [12, 40]. */
 int sph_overlay_font_px(const sph_image *img);
+/* Axes triad: the world X, Y, Z directions as seen on screen (dir[k] = the
+ * screen x, y (y up) of unit axis k, length <= 1) drawn from (x, y) as red,
+ * green and blue segments len pixels long, labelled. */
+void sph_overlay_axes(sph_image *img, sph_text *t, int x, int y, int len,
+                      const double dir[3][2]);
 /* Label block with top-left corner (x, y): black text on a translucent white
  * box, one line per '\n', e.g. "twisting_column   t = 0.0250 s". */
 void sph_overlay_label(sph_image *img, sph_text *t, int x, int y,

@@ -82,6 +82,7 @@ typedef struct png_sink {
   int follow;          /* refit the camera to the current bodies */
   int time_decimals;   /* of the time label: those of the output interval */
   int dim;             /* 2 or 3: the sphere radius factor is J^(1/dim) */
+  int axes;            /* draw the axes triad */
   double fit_lo[3], fit_hi[3]; /* the box the camera frames */
   const sph_scene *scene;
   int field, ncomp;
@@ -472,6 +473,25 @@ static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
   snprintf(label, sizeof label, "%s\nt = %.*f s", p->name, p->time_decimals,
            fr->time);
   sph_overlay_label(&p->img, p->text, W / 64, H / 36, label);
+  if (p->axes) { /* the world axes on screen: (right, up) components */
+    const sph_view *v = &fr->view;
+    double f[3], r[3], u[3], dir[3][2];
+    for (int k = 0; k < 3; ++k)
+      f[k] = v->target[k] - v->eye[k];
+    if (right_of(f, v->up, r)) {
+      u[0] = r[1] * f[2] - r[2] * f[1];
+      u[1] = r[2] * f[0] - r[0] * f[2];
+      u[2] = r[0] * f[1] - r[1] * f[0];
+      double ul = sqrt(dot3(u, u));
+      for (int k = 0; k < 3; ++k) {
+        dir[k][0] = r[k];
+        dir[k][1] = ul > 0.0 ? u[k] / ul : 0.0;
+      }
+      int len = H / 14 > 8 ? H / 14 : 8;
+      sph_overlay_axes(&p->img, p->text, W / 32 + len, H - H / 14 - len / 2,
+                       len, dir);
+    }
+  }
   return sph_image_write_png(path, &p->img, err);
 }
 
@@ -613,6 +633,7 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   png_view(sim, &p->view, p->fit_lo, p->fit_hi);
   SPH_TRY(sph_view_check(&p->view, err));
   p->scene = sim->scene;
+  p->axes = o->axes;
   p->follow = o->camera.follow && !o->camera.has_position;
   /* the fewest decimals that write every output time exactly (0.005 -> 3,
    * 0.0025 -> 4, 2e-6 -> 6), at least one */

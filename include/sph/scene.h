@@ -166,6 +166,7 @@ typedef struct sph_png_output {
   double clip_normal[3], clip_at;
   int cut_half; /* per body, only the half behind its reference centroid */
   int ghost;    /* the reference configuration drawn behind the frame */
+  int axes;     /* the world axes triad in the bottom-left corner */
 } sph_png_output;
 
 typedef struct sph_output {

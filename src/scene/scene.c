@@ -855,9 +855,9 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   sph_png_output *p = &s->output.png;
   if (!png)
     return SPH_OK;
-  static const char *const keys[] = {"width",    "height", "color", "range",
-                                     "colormap", "camera", "mp4",   "fps",
-                                     "clip",     "cut",    "ghost", NULL};
+  static const char *const keys[] = {
+      "width", "height", "color", "range", "colormap", "camera", "mp4",
+      "fps",   "clip",   "cut",   "ghost", "axes",     NULL};
   SPH_TRY(sph_node_check_keys(png, keys, err));
   p->enabled = 1;
   long w, h;
@@ -968,6 +968,7 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
                           "cut is none or half, got '%s'", cut);
   p->cut_half = !strcmp(cut, "half");
   SPH_TRY(sph_node_get_bool(png, "ghost", 0, 0, &p->ghost, err));
+  SPH_TRY(sph_node_get_bool(png, "axes", 0, 0, &p->axes, err));
   return SPH_OK;
 }
 

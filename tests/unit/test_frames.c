@@ -178,6 +178,32 @@ START_TEST(follow_camera_keeps_the_bar_clear) {
 }
 END_TEST
 
+START_TEST(axes_triad) {
+  /* axes: true adds the world axes in the bottom-left corner and changes
+   * nothing else: X red, Y green there; the rest of the frame as without */
+  sph_image plain, axes;
+  render("noaxes", "", 0.0, &plain);
+  render("axes", ", axes: true", 0.0, &axes);
+  long outside = 0, red = 0, green = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const unsigned char *a = px(&axes, x, y), *b = px(&plain, x, y);
+      int corner = x < W / 4 && y > H / 2;
+      if (!corner)
+        outside += memcmp(a, b, 3) != 0;
+      else if (memcmp(a, b, 3)) {
+        red += a[0] > 150 && a[1] < 90 && a[2] < 90;
+        green += a[1] > 110 && a[0] < 90 && a[2] < 90;
+      }
+    }
+  ck_assert_int_eq(outside, 0);
+  ck_assert_msg(red > 10 && green > 10, "triad: %ld red, %ld green pixels", red,
+                green);
+  sph_image_destroy(&plain);
+  sph_image_destroy(&axes);
+}
+END_TEST
+
 START_TEST(ghost_outline) {
   /* 10 m/s for 0.02 s: the block moves one spacing (0.2 m) to the right */
   sph_image plain, ghost;
@@ -223,6 +249,7 @@ int main(void) {
   tcase_add_test(tc, cut_half);
   tcase_add_test(tc, ghost_outline);
   tcase_add_test(tc, follow_camera_keeps_the_bar_clear);
+  tcase_add_test(tc, axes_triad);
   suite_add_tcase(s, tc);
   int rc = sph_test_run(s);
   char cmd[256];
