@@ -372,3 +372,31 @@ void sph_overlay_axes(sph_image *img, sph_text *t, int x, int y, int len,
                     rgb[k]);
   }
 }
+
+void sph_overlay_scale_bar(sph_image *img, sph_text *t, int x, int y,
+                           double metres_per_px) {
+  if (!img || !img->rgba || !(metres_per_px > 0.0) || !isfinite(metres_per_px))
+    return;
+  /* the nice length nearest to an eighth of the frame's width */
+  double want = img->width / 8.0 * metres_per_px, best = 0.0;
+  int k = (int)floor(log10(want));
+  static const int mult[3] = {1, 2, 5};
+  for (int e = k - 1; e <= k + 1; ++e)
+    for (int j = 0; j < 3; ++j) {
+      double v = mult[j] * pow(10.0, e);
+      if (best == 0.0 || fabs(log(v / want)) < fabs(log(best / want)))
+        best = v;
+    }
+  int len = (int)floor(best / metres_per_px + 0.5);
+  static const unsigned char black[3] = {0, 0, 0};
+  fill_rect(img, x, y - 1, x + len, y + 2, black);
+  fill_rect(img, x, y - 6, x + 2, y + 2, black);
+  fill_rect(img, x + len - 2, y - 6, x + len, y + 2, black);
+  if (t) {
+    char label[32];
+    snprintf(label, sizeof label, "%g m", best);
+    int px = sph_overlay_font_px(img) * 3 / 4;
+    int w = sph_text_width(t, px, label);
+    sph_text_draw(t, img, x + (len - w) / 2, y - 9, px, label, black);
+  }
+}

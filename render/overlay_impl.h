@@ -110,6 +110,11 @@ int sph_overlay_font_px(const sph_image *img);
  * green and blue segments len pixels long, labelled. */
 void sph_overlay_axes(sph_image *img, sph_text *t, int x, int y, int len,
                       const double dir[3][2]);
+/* Scale bar from (x, y) rightwards: the length of 1, 2 or 5 x 10^k metres
+ * nearest to an eighth of the frame's width at metres_per_px, end ticks,
+ * the length written above it. */
+void sph_overlay_scale_bar(sph_image *img, sph_text *t, int x, int y,
+                           double metres_per_px);
 /* Label block with top-left corner (x, y): black text on a translucent white
  * box, one line per '\n', e.g. "twisting_column   t = 0.0250 s". */
 void sph_overlay_label(sph_image *img, sph_text *t, int x, int y,

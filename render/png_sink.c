@@ -83,6 +83,7 @@ typedef struct png_sink {
   int time_decimals;   /* of the time label: those of the output interval */
   int dim;             /* 2 or 3: the sphere radius factor is J^(1/dim) */
   int axes;            /* draw the axes triad */
+  int scale_bar;       /* draw the scale bar */
   double fit_lo[3], fit_hi[3]; /* the box the camera frames */
   const sph_scene *scene;
   int field, ncomp;
@@ -492,6 +493,16 @@ static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
                        len, dir);
     }
   }
+  if (p->scale_bar) { /* metres per pixel at the camera's target */
+    const sph_view *v = &fr->view;
+    double d[3] = {v->target[0] - v->eye[0], v->target[1] - v->eye[1],
+                   v->target[2] - v->eye[2]};
+    double mpp = v->ortho
+                     ? v->ortho_height / H
+                     : 2.0 * sqrt(dot3(d, d)) *
+                           tan(0.5 * v->fovy_deg * 3.14159265358979 / 180) / H;
+    sph_overlay_scale_bar(&p->img, p->text, W / 5, H - H / 14, mpp);
+  }
   return sph_image_write_png(path, &p->img, err);
 }
 
@@ -634,6 +645,7 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   SPH_TRY(sph_view_check(&p->view, err));
   p->scene = sim->scene;
   p->axes = o->axes;
+  p->scale_bar = o->scale_bar;
   p->follow = o->camera.follow && !o->camera.has_position;
   /* the fewest decimals that write every output time exactly (0.005 -> 3,
    * 0.0025 -> 4, 2e-6 -> 6), at least one */

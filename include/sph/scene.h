@@ -164,9 +164,10 @@ typedef struct sph_png_output {
   double fps; /* its frame rate */
   int clip;   /* draw only particles with clip_normal . x <= clip_at */
   double clip_normal[3], clip_at;
-  int cut_half; /* per body, only the half behind its reference centroid */
-  int ghost;    /* the reference configuration drawn behind the frame */
-  int axes;     /* the world axes triad in the bottom-left corner */
+  int cut_half;  /* per body, only the half behind its reference centroid */
+  int ghost;     /* the reference configuration drawn behind the frame */
+  int axes;      /* the world axes triad in the bottom-left corner */
+  int scale_bar; /* a length scale at the camera's target */
 } sph_png_output;
 
 typedef struct sph_output {

@@ -856,8 +856,8 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   if (!png)
     return SPH_OK;
   static const char *const keys[] = {
-      "width", "height", "color", "range", "colormap", "camera", "mp4",
-      "fps",   "clip",   "cut",   "ghost", "axes",     NULL};
+      "width", "height", "color", "range", "colormap", "camera",    "mp4",
+      "fps",   "clip",   "cut",   "ghost", "axes",     "scale_bar", NULL};
   SPH_TRY(sph_node_check_keys(png, keys, err));
   p->enabled = 1;
   long w, h;
@@ -969,6 +969,7 @@ static sph_status parse_png(sph_scene *s, sph_node *out, sph_error *err) {
   p->cut_half = !strcmp(cut, "half");
   SPH_TRY(sph_node_get_bool(png, "ghost", 0, 0, &p->ghost, err));
   SPH_TRY(sph_node_get_bool(png, "axes", 0, 0, &p->axes, err));
+  SPH_TRY(sph_node_get_bool(png, "scale_bar", 0, 0, &p->scale_bar, err));
   return SPH_OK;
 }
 

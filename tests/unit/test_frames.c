@@ -5,6 +5,7 @@
  * translation (the reference silhouette appears where the block was). */
 #include "test_util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -204,6 +205,38 @@ START_TEST(axes_triad) {
 }
 END_TEST
 
+START_TEST(scale_bar_length) {
+  /* the bar is a nice length (1, 2 or 5 x 10^k m) at the frame's scale:
+   * the block's 1.2 m (centres 0..1, spheres 0.1 m each side) spans
+   * a0..a1 in the same front ortho view */
+  sph_image plain, bar;
+  char keys[256];
+  snprintf(keys, sizeof keys, "%s, scale_bar: true", front);
+  render("plainbar", front, 0.0, &plain);
+  render("bar", keys, 0.0, &bar);
+  int a0, a1;
+  extent(&plain, &a0, &a1);
+  double px_per_m = (a1 + 1 - a0) / 1.2;
+  /* the longest black run of a row in the bottom band */
+  int longest = 0;
+  for (int y = H - H / 7; y < H; ++y) {
+    int run = 0;
+    for (int x = 0; x < W; ++x) {
+      const unsigned char *p = px(&bar, x, y);
+      run = p[0] < 40 && p[1] < 40 && p[2] < 40 ? run + 1 : 0;
+      longest = run > longest ? run : longest;
+    }
+  }
+  double metres = longest / px_per_m;
+  double mant = metres / pow(10.0, floor(log10(metres)));
+  ck_assert_msg(fabs(mant - 1.0) < 0.05 || fabs(mant - 2.0) < 0.1 ||
+                    fabs(mant - 5.0) < 0.25 || fabs(mant - 10.0) < 0.5,
+                "bar of %d px is %g m at %g px/m", longest, metres, px_per_m);
+  sph_image_destroy(&plain);
+  sph_image_destroy(&bar);
+}
+END_TEST
+
 START_TEST(ghost_outline) {
   /* 10 m/s for 0.02 s: the block moves one spacing (0.2 m) to the right */
   sph_image plain, ghost;
@@ -250,6 +283,7 @@ int main(void) {
   tcase_add_test(tc, ghost_outline);
   tcase_add_test(tc, follow_camera_keeps_the_bar_clear);
   tcase_add_test(tc, axes_triad);
+  tcase_add_test(tc, scale_bar_length);
   suite_add_tcase(s, tc);
   int rc = sph_test_run(s);
   char cmd[256];
