@@ -18,6 +18,10 @@
 #include "sph/scene.h"
 #include "sph/status.h"
 
+/* A stable time step below this fraction of the largest one of the run
+ * stops it (`step` indicator): particles collapsing onto each other. */
+#define SPH_DT_COLLAPSE 1e-3
+
 typedef struct sph_sim sph_sim;
 typedef struct sph_term sph_term;
 
@@ -107,6 +111,7 @@ struct sph_sim {
   double t;
   unsigned long steps;
   double dt_min, dt_max, dt_last;
+  double dt_stable_peak; /* largest stable step of this process */
   sph_term terms[SPH_MAX_TERMS];
   int nterms;
   sph_timer timers[SPH_MAX_TIMERS];

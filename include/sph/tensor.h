@@ -192,4 +192,24 @@ static inline void sph_mat3_sym_eigen(const double A[9], double w[3],
   w[2] = a[8];
 }
 
+/* Smallest and largest eigenvalue of a symmetric A (trigonometric method). */
+static inline void sph_mat3_sym_extremes(const double A[9], double *lo,
+                                         double *hi) {
+  double p1 = A[1] * A[1] + A[2] * A[2] + A[5] * A[5];
+  double q = (A[0] + A[4] + A[8]) / 3.0;
+  double p2 = (A[0] - q) * (A[0] - q) + (A[4] - q) * (A[4] - q) +
+              (A[8] - q) * (A[8] - q) + 2.0 * p1;
+  if (p2 <= 1e-30 * q * q) {
+    *lo = *hi = q;
+    return;
+  }
+  double p = sqrt(p2 / 6.0), B[9];
+  for (int k = 0; k < 9; ++k)
+    B[k] = (A[k] - (k % 4 == 0) * q) / p;
+  double r = 0.5 * sph_mat3_det(B);
+  double phi = r <= -1.0 ? M_PI / 3.0 : (r >= 1.0 ? 0.0 : acos(r) / 3.0);
+  *hi = q + 2.0 * p * cos(phi);
+  *lo = q + 2.0 * p * cos(phi + 2.0 * M_PI / 3.0);
+}
+
 #endif

@@ -14,7 +14,8 @@
 #include "sph/sink.h"
 
 const char *const study_norm_names[STUDY_NORMS] = {
-    "l2_velocity", "l2_stress", "l2_displacement", "period_error"};
+    "l2_velocity", "l2_stress", "l2_displacement", "h1_displacement",
+    "period_error"};
 
 static const char *const fixed_columns[] = {"particles",
                                             "dp",
@@ -24,6 +25,7 @@ static const char *const fixed_columns[] = {"particles",
                                             "l2_velocity",
                                             "l2_stress",
                                             "l2_displacement",
+                                            "h1_displacement",
                                             "period_error",
                                             "period",
                                             "energy_drift",
@@ -32,7 +34,7 @@ static const char *const fixed_columns[] = {"particles",
                                             "stable",
                                             "reason",
                                             NULL};
-#define NFIXED 15
+#define NFIXED 16
 
 static void csv_field(FILE *f, const char *s) {
   if (!strpbrk(s, ",\"\n")) {

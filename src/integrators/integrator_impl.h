@@ -27,6 +27,15 @@ typedef struct sph_ode {
  * u* = u^n + dt f(u^n); u** = u* + dt f(u*); u^{n+1} = (u^n + u**) / 2. */
 sph_status sph_tvd_rk2_step(sph_ode *ode, double t, double dt, sph_error *err);
 
+/* Three-stage SSP-RK3 (seed 004 eq. 30, Shu-Osher): u* = u^n + dt f(u^n);
+ * u** = 3/4 u^n + 1/4 (u* + dt f(u*)); u^{n+1} = 1/3 u^n + 2/3 (u** +
+ * dt f(u**)); stages at t, t + dt, t + dt / 2 (rhs stage 0, 1, 2). */
+sph_status sph_ssp_rk3_step(sph_ode *ode, double t, double dt, sph_error *err);
+
+/* Either of the two, chosen once by a method at set-up. */
+typedef sph_status (*sph_rk_step)(sph_ode *ode, double t, double dt,
+                                  sph_error *err);
+
 /* Leap-frog (kick-drift-kick) for positions x and momenta per reference
  * volume p = rho0 v: `rates` fills dp from the current x and p; the rates
  * of the end of a step are reused at the start of the next. */

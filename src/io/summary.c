@@ -155,14 +155,15 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     } q[] = {{"l2_velocity", e.l2_velocity},
              {"l2_stress", e.l2_stress},
              {"l2_displacement", e.l2_displacement},
+             {"h1_displacement", e.h1_displacement},
              {"period", e.period},
              {"period_reference", e.period_value},
              {"period_error", e.period_error},
              {"period_tolerance", e.period_tolerance}};
     const char *sep = ",\n  \"error\": {";
-    size_t k0 = e.period_value > 0.0 ? 3 : 0, k1 = k0 ? 7 : 3;
+    size_t k0 = e.period_value > 0.0 ? 4 : 0, k1 = k0 ? 8 : 4;
     for (size_t k = k0; k < k1; ++k) {
-      if (k == 6 && isnan(q[k].x)) /* no tolerance given */
+      if (k == 7 && isnan(q[k].x)) /* no tolerance given */
         continue;
       fprintf(f, "%s\"%s\": ", sep, q[k].key);
       json_number(f, q[k].x);

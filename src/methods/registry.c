@@ -2,11 +2,8 @@
 #include "methods/registry_impl.h"
 
 static const sph_method_ops *const methods[] = {
-    &tl_jst_method_ops,
-    &tl_csph_method_ops,
-    &ul_sph_method_ops,
-    &ul_csph_method_ops,
-    NULL,
+    &tl_jst_method_ops,  &tl_csph_method_ops, &ul_sph_method_ops,
+    &ul_csph_method_ops, &tl_bond_method_ops, NULL,
 };
 
 const sph_method_ops *const *sph_method_list(void) { return methods; }

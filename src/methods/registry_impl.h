@@ -10,5 +10,6 @@ extern const sph_method_ops tl_jst_method_ops;
 extern const sph_method_ops tl_csph_method_ops;
 extern const sph_method_ops ul_sph_method_ops;
 extern const sph_method_ops ul_csph_method_ops;
+extern const sph_method_ops tl_bond_method_ops;
 
 #endif

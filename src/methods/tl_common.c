@@ -563,7 +563,7 @@ void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
 }
 
 void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
-               const double *J) {
+               const double *J, const double *Fs) {
   sph_particles *ps = sim->ps;
   long n = (long)ps->n;
   const double *X = ps->field[SPH_FIELD_POSITION0];
@@ -587,11 +587,12 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
       v[3 * a + c] = p[3 * a + c] / ref->rho0[a];
       u[3 * a + c] = x[3 * a + c] - X[3 * a + c];
     }
-    double detF = sph_mat3_det(F + 9 * a);
+    const double *Fa = (Fs ? Fs : F) + 9 * a;
+    double detF = sph_mat3_det(Fa);
     Jf[a] = J ? J[a] : detF;
     /* Cauchy stress sigma = P F^T / det F */
     double Ft[9], S[9];
-    sph_mat3_transpose(F + 9 * a, Ft);
+    sph_mat3_transpose(Fa, Ft);
     sph_mat3_mul(P + 9 * a, Ft, S);
     for (int k = 0; k < 9; ++k)
       S[k] /= detF;
@@ -605,22 +606,6 @@ void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
       }
     vm[a] = sqrt(1.5 * dev2);
   }
-}
-
-/* largest eigenvalue of a symmetric 3x3 matrix (trigonometric method) */
-static double sym3_max_eigenvalue(const double A[9]) {
-  double p1 = A[1] * A[1] + A[2] * A[2] + A[5] * A[5];
-  double q = (A[0] + A[4] + A[8]) / 3.0;
-  double p2 = (A[0] - q) * (A[0] - q) + (A[4] - q) * (A[4] - q) +
-              (A[8] - q) * (A[8] - q) + 2.0 * p1;
-  if (p2 <= 1e-30 * q * q)
-    return q;
-  double p = sqrt(p2 / 6.0), B[9];
-  for (int k = 0; k < 9; ++k)
-    B[k] = (A[k] - (k % 4 == 0) * q) / p;
-  double r = 0.5 * sph_mat3_det(B);
-  double phi = r <= -1.0 ? M_PI / 3.0 : (r >= 1.0 ? 0.0 : acos(r) / 3.0);
-  return q + 2.0 * p * cos(phi);
 }
 
 double tl_max_wave_speed(const tl_reference *ref, const double *F) {
@@ -642,7 +627,9 @@ double tl_max_wave_speed(const tl_reference *ref, const double *F) {
     }
     sph_material_acoustic_tensors(m, Fa, Q);
     for (int d = 0; d < 3; ++d) {
-      double c2 = sym3_max_eigenvalue(Q + 9 * d) / m->density;
+      double lo, hi;
+      sph_mat3_sym_extremes(Q + 9 * d, &lo, &hi);
+      double c2 = hi / m->density;
       c2max = c2 > c2max ? c2 : c2max;
     }
   }
@@ -750,7 +737,7 @@ sph_status tl_leapfrog_step(sph_sim *sim, const tl_reference *ref,
 sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
                               sph_leapfrog *lf, const double *dp,
                               sph_error *err) {
-  tl_derive(sim, ref, NULL, NULL);
+  tl_derive(sim, ref, NULL, NULL, NULL);
   if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
     if (!lf->have_rates)
       SPH_TRY(lf->rates(lf->ctx, sim->t, err));

@@ -129,9 +129,10 @@ void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
 /* Derived fields of the real particles: velocity, displacement, J, Cauchy
  * stress, pressure tr(sigma)/3 (seed 000 eq. 11), von Mises; copies the
  * state into the particle fields when the method keeps its own arrays.
- * J may be NULL (det F); P must hold the stress of the state. */
+ * P must hold the stress of the state, evaluated at Fs (NULL: the state's
+ * F), which J (NULL: det Fs) and the Cauchy stress take. */
 void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,
-               const double *J);
+               const double *J, const double *Fs);
 
 /* Largest p-wave speed of the current state (seed 000 eq. 44, "c_p from
  * the current state"): for each particle the largest eigenvalue of the

@@ -1,5 +1,6 @@
 /* Reference solutions (see include/sph/reference.h): the swinging cube of
- * seed 000 sec. 8.2 eq. 52, and a measured period against a scalar value.
+ * seed 000 sec. 8.2 eq. 52, the swinging plate of seed 004 sec. 5.1 eq. 42-43,
+ * and a measured period against a scalar value.
  *
  * Eq. 52 for any amplitudes (A1, A2, A3) = (A, B, C): with a = pi/2 and
  * u_i = A_i f_i(X) g(t), f = (sin cos cos, cos sin cos, cos cos sin)(a X),
@@ -19,7 +20,7 @@
 
 #include "sph/tensor.h"
 
-typedef enum { REF_SWINGING_CUBE, REF_PERIOD } ref_kind;
+typedef enum { REF_SWINGING_CUBE, REF_SWINGING_PLATE, REF_PERIOD } ref_kind;
 
 /* the period observer's state, kept as doubles for checkpoints */
 enum { OBS_U, OBS_T, OBS_SIGN, OBS_CROSSINGS, OBS_FIRST, OBS_LAST, OBS_N };
@@ -39,6 +40,7 @@ struct sph_reference {
   double omega_s;      /* sqrt(3)/2 c_s pi */
   double lambda, mu;   /* small strain moduli of the body */
   double P_amp, v_amp; /* normalisations */
+  int from_rest;       /* u = U0 sin(w t) f: zero displacement at t = 0 */
 };
 
 /* a mode of amplitudes A at U0 = 1: f_i = A_i f_i(X), G_ij = d f_i / d X_j */
@@ -63,20 +65,30 @@ static void mode(const double A[3], const double X[3], double f[3],
   }
 }
 
-/* the exact displacement, velocity and displacement gradient at (X, t) */
+/* the exact displacement, velocity and displacement gradient at (X, t):
+ * each part is f cos(w t) (the cube, released from rest deformed) or
+ * f sin(w t) (the plate, set moving from the undeformed state) */
 static void exact(const sph_reference *r, const double X[3], double t,
                   double u[3], double v[3], double G[9]) {
   double fd[3], Gd[9], fs[3], Gs[9];
   mode(r->Ad, X, fd, Gd);
   mode(r->As, X, fs, Gs);
-  const double cd = cos(r->omega_d * t), sd = sin(r->omega_d * t);
-  const double cs = cos(r->omega_s * t), ss = sin(r->omega_s * t);
+  double pd = r->omega_d * t, ps = r->omega_s * t;
+  /* displacement factors and their time derivatives */
+  double ud = cos(pd), us = cos(ps);
+  double vd = -r->omega_d * sin(pd), vs = -r->omega_s * sin(ps);
+  if (r->from_rest) {
+    ud = sin(pd);
+    us = sin(ps);
+    vd = r->omega_d * cos(pd);
+    vs = r->omega_s * cos(ps);
+  }
   for (int i = 0; i < 3; ++i) {
-    u[i] = r->U0 * (cd * fd[i] + cs * fs[i]);
-    v[i] = -r->U0 * (r->omega_d * sd * fd[i] + r->omega_s * ss * fs[i]);
+    u[i] = r->U0 * (ud * fd[i] + us * fs[i]);
+    v[i] = r->U0 * (vd * fd[i] + vs * fs[i]);
   }
   for (int k = 0; k < 9; ++k)
-    G[k] = r->U0 * (cd * Gd[k] + cs * Gs[k]);
+    G[k] = r->U0 * (ud * Gd[k] + us * Gs[k]);
 }
 
 /* small strain stress of a displacement gradient */
@@ -119,12 +131,6 @@ static sph_status swinging_cube_create(sph_reference *r, const sph_scene *s,
                                        sph_node *n, sph_error *err) {
   static const char *const keys[] = {"analytic", "U0", "A", "B", "C", NULL};
   SPH_TRY(sph_node_check_keys(n, keys, err));
-  const char *kind;
-  SPH_TRY(sph_node_get_string(n, "analytic", 1, NULL, &kind, err));
-  if (strcmp(kind, "swinging_cube"))
-    return sph_node_error(sph_node_child(n, "analytic"), err, SPH_ERR_RANGE,
-                          "unknown reference '%s' (known: swinging_cube)",
-                          kind);
   if (s->dimension != 3 || s->nbodies != 1)
     return sph_node_error(n, err, SPH_ERR_ARG,
                           "swinging_cube needs one body in 3D");
@@ -153,6 +159,50 @@ static sph_status swinging_cube_create(sph_reference *r, const sph_scene *s,
   return SPH_OK;
 }
 
+/* reference: {analytic: swinging_plate, U: 0.01} on [0, 2]^2 (seed 004
+ * eq. 42-43): the zero-sum mode A = (-1, 1) of the cube in the plane,
+ * w = (pi / 2) sqrt(2 mu / rho) */
+static sph_status swinging_plate_create(sph_reference *r, const sph_scene *s,
+                                        sph_node *n, sph_error *err) {
+  static const char *const keys[] = {"analytic", "U", NULL};
+  SPH_TRY(sph_node_check_keys(n, keys, err));
+  if (s->dimension != 2 || s->nbodies != 1)
+    return sph_node_error(n, err, SPH_ERR_ARG,
+                          "swinging_plate needs one body in 2D");
+  if (s->bodies[0].transform.given)
+    return sph_node_error(n, err, SPH_ERR_ARG,
+                          "swinging_plate is given in the world frame: the "
+                          "body cannot have a transform");
+  SPH_TRY(sph_node_get_double(n, "U", 0, 0.01, &r->U0, err));
+  if (!(r->U0 > 0.0) || !isfinite(r->U0))
+    return sph_node_error(sph_node_child(n, "U"), err, SPH_ERR_RANGE,
+                          "U must be a positive amplitude");
+  const sph_material *m = &s->materials[s->bodies[0].material];
+  r->lambda = m->lambda;
+  r->mu = m->mu;
+  r->As[0] = -1.0;
+  r->As[1] = 1.0;
+  r->omega_s = M_PI / 2.0 * sqrt(2.0 * m->mu / m->density);
+  r->v_amp = r->U0 * r->omega_s;
+  r->from_rest = 1;
+  r->kind = REF_SWINGING_PLATE;
+  return SPH_OK;
+}
+
+static sph_status analytic_create(sph_reference *r, const sph_scene *s,
+                                  sph_node *n, sph_error *err) {
+  const char *kind;
+  SPH_TRY(sph_node_get_string(n, "analytic", 1, NULL, &kind, err));
+  if (!strcmp(kind, "swinging_plate"))
+    return swinging_plate_create(r, s, n, err);
+  if (strcmp(kind, "swinging_cube"))
+    return sph_node_error(sph_node_child(n, "analytic"), err, SPH_ERR_RANGE,
+                          "unknown reference '%s' (known: swinging_cube, "
+                          "swinging_plate)",
+                          kind);
+  return swinging_cube_create(r, s, n, err);
+}
+
 sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
                                 sph_error *err) {
   *out = NULL;
@@ -162,9 +212,8 @@ sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
   sph_reference *r = calloc(1, sizeof *r);
   if (!r)
     return sph_error_set(err, SPH_ERR_NOMEM, "reference");
-  sph_status st = sph_node_child(n, "period")
-                      ? period_create(r, s, n, err)
-                      : swinging_cube_create(r, s, n, err);
+  sph_status st = sph_node_child(n, "period") ? period_create(r, s, n, err)
+                                              : analytic_create(r, s, n, err);
   if (st != SPH_OK) {
     free(r);
     return st;
@@ -209,7 +258,13 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
       ps->field[SPH_FIELD_POSITION][3 * a + c] = X[c] + u[c];
       ps->field[SPH_FIELD_VELOCITY][3 * a + c] = v[c];
     }
-    stress(r, G, P);
+    /* the stress amplitude: both parts at their extremes */
+    double f[3], Gd[9], Gs[9], Ga[9];
+    mode(r->Ad, X, f, Gd);
+    mode(r->As, X, f, Gs);
+    for (int k = 0; k < 9; ++k)
+      Ga[k] = r->U0 * (Gd[k] + Gs[k]);
+    stress(r, Ga, P);
     rw->P_amp = fmax(rw->P_amp, sqrt(sph_mat3_ddot(P, P)));
     /* an initial state the material can have: finite, not inverted */
     double J = sph_mat3_det(F);
@@ -258,7 +313,7 @@ int sph_reference_state(sph_reference *r, sph_state_array *arr) {
 
 void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
                           sph_reference_error *e) {
-  e->l2_velocity = e->l2_stress = e->l2_displacement = NAN;
+  e->l2_velocity = e->l2_stress = e->l2_displacement = e->h1_displacement = NAN;
   e->period = e->period_value = e->period_error = NAN;
   e->period_tolerance = r->tolerance;
   if (r->kind == REF_PERIOD) {
@@ -273,7 +328,7 @@ void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
     return;
   }
   const sph_particles *ps = sim->ps;
-  double sv = 0.0, ev = 0.0, eP = 0.0, eu = 0.0;
+  double sv = 0.0, ev = 0.0, eP = 0.0, eu = 0.0, eg = 0.0;
   for (size_t a = 0; a < ps->n; ++a) {
     double uex[3], vex[3], G[9], P[9];
     const double V = ps->field[SPH_FIELD_VOLUME0][a];
@@ -286,11 +341,16 @@ void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
       ev += V * (v[i] - vex[i]) * (v[i] - vex[i]);
       eu += V * (u[i] - uex[i]) * (u[i] - uex[i]);
     }
-    for (int k = 0; k < 9; ++k)
+    const double *Fn = ps->field[SPH_FIELD_DEFGRAD] + 9 * a;
+    for (int k = 0; k < 9; ++k) {
+      double dG = Fn[k] - (k % 4 == 0) - G[k]; /* grad u_h = F - I */
       eP += V * (Pn[k] - P[k]) * (Pn[k] - P[k]);
+      eg += V * dG * dG;
+    }
     sv += V;
   }
   e->l2_velocity = sqrt(ev / sv) / r->v_amp;
   e->l2_stress = sqrt(eP / sv) / r->P_amp;
   e->l2_displacement = sqrt(eu / sv) / r->U0;
+  e->h1_displacement = sqrt(eg / sv) / (r->U0 * M_PI / 2.0);
 }

@@ -192,6 +192,14 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NUMERIC,
                          "stable time step %g at t = %g is not positive", dt,
                          sim->t);
+  /* particles closing onto each other shrink a pair-based step without
+   * bound: a run that would never end */
+  if (dt < SPH_DT_COLLAPSE * sim->dt_stable_peak)
+    return sph_error_set(err, SPH_ERR_RANGE,
+                         "time step collapse: stable step %.3g s at t = %g "
+                         "is below %g of the largest so far (%.3g s)",
+                         dt, sim->t, SPH_DT_COLLAPSE, sim->dt_stable_peak);
+  sim->dt_stable_peak = fmax(sim->dt_stable_peak, dt);
   if (dt > dt_cap)
     dt = dt_cap;
   sph_status st = sim->method->step(sim, dt, err);

@@ -1,6 +1,8 @@
 /* Jameson-Schmidt-Turkel dissipation, seed 000 eq. 35-38 (seed 003
  * eq. 13-15): D(u) = eps2 c_p h L[u] - eps4 c_p h^3 L[L[u]] with the
  * corrected particle Laplacian L[u]_a = sum_b V_b (u_b - u_a) Lap W~_b(X_a),
+ * or in the symmetrised form of seed 004 eq. 28 (outer sums over the pair
+ * mean of Lap W~, the inner L[u] as eq. 27),
  * for u = p (into dp) or u = J (into dJ), never F or H (involutions). The
  * conservative projections of eq. 49 (p: zero sum and moment per body) and
  * eq. 51 (J: zero volume-weighted sum per body) are applied when asked. */
@@ -18,10 +20,10 @@ typedef struct jst {
 /* out_a = cs self_a + cl L[u]_a with L[u]_a = sum_b (V_b Lap W~_b(X_a))
  * (u_b - u_a) (self may be NULL when cs = 0), one loop per component
  * count so that the compiler sees it */
-static void laplacian3(const jst *j, const double *u, const double *self,
-                       double cs, double cl, double *out, long n) {
+static void laplacian3(const jst *j, const double *wl, const double *u,
+                       const double *self, double cs, double cl, double *out,
+                       long n) {
   const sph_neighbors *nl = j->p.nl;
-  const double *wl = j->p.lap;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double s[3] = {0.0, 0.0, 0.0};
@@ -37,10 +39,10 @@ static void laplacian3(const jst *j, const double *u, const double *self,
   }
 }
 
-static void laplacian1(const jst *j, const double *u, const double *self,
-                       double cs, double cl, double *out, long n) {
+static void laplacian1(const jst *j, const double *wl, const double *u,
+                       const double *self, double cs, double cl, double *out,
+                       long n) {
   const sph_neighbors *nl = j->p.nl;
-  const double *wl = j->p.lap;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double s = 0.0;
@@ -50,12 +52,13 @@ static void laplacian1(const jst *j, const double *u, const double *self,
   }
 }
 
-static void laplacian(const jst *j, const double *u, const double *self,
-                      double cs, double cl, double *out, long n) {
+static void laplacian(const jst *j, const double *wl, const double *u,
+                      const double *self, double cs, double cl, double *out,
+                      long n) {
   if (j->p.ncomp == 3)
-    laplacian3(j, u, self, cs, cl, out, n);
+    laplacian3(j, wl, u, self, cs, cl, out, n);
   else
-    laplacian1(j, u, self, cs, cl, out, n);
+    laplacian1(j, wl, u, self, cs, cl, out, n);
 }
 
 static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
@@ -67,9 +70,10 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   int nc = j->p.ncomp;
   const double *u = nc == 3 ? stage->p : stage->J;
   double *rate = nc == 3 ? stage->dp : stage->dJ;
-  double c2 = j->p.eps2 * j->p.cp * j->p.h;
-  double c4 = j->p.eps4 * j->p.cp * j->p.h * j->p.h * j->p.h;
-  laplacian(j, u, NULL, 0.0, 1.0, j->lu, n);
+  double cp = j->p.cp_now ? *j->p.cp_now : j->p.cp;
+  double c2 = j->p.eps2 * cp * j->p.h;
+  double c4 = j->p.eps4 * cp * j->p.h * j->p.h * j->p.h;
+  laplacian(j, j->p.lap, u, NULL, 0.0, 1.0, j->lu, n);
   if (sim->mirror) { /* the images' Laplacians mirror their sources' */
     if (nc == 3)
       sph_mirror_vector(sim->mirror, j->lu);
@@ -77,8 +81,13 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
       sph_mirror_scalar(sim->mirror, j->lu, 0.0);
   }
   long len = nc * n;
-  if (c4 != 0.0) { /* D = c2 L[u] - c4 L[L[u]] */
-    laplacian(j, j->lu, j->lu, c2, -c4, j->d, n);
+  if (j->p.lap_sym) { /* eq. 28: D = c2 S[u] - c4 S[L[u]] */
+    if (c2 != 0.0)
+      laplacian(j, j->p.lap_sym, u, NULL, 0.0, c2, j->d, n);
+    laplacian(j, j->p.lap_sym, j->lu, c2 != 0.0 ? j->d : NULL, 1.0, -c4, j->d,
+              n);
+  } else if (c4 != 0.0) { /* D = c2 L[u] - c4 L[L[u]] */
+    laplacian(j, j->p.lap, j->lu, j->lu, c2, -c4, j->d, n);
   } else {
 #pragma omp parallel for schedule(static)
     for (long i = 0; i < len; ++i)

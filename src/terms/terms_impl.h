@@ -33,6 +33,11 @@ typedef struct jst_params {
   int ncomp;
   double eps2, eps4, cp, h;
   int project;
+  /* seed 004 eq. 28 (NULL: seed 000 eq. 35-38): the outer sums take
+   * V_b (Lap W~_b(X_a) + Lap W~_a(X_b)) / 2 per slot, the inner Laplacian
+   * (eq. 27) stays `lap` */
+  const double *lap_sym;
+  const double *cp_now; /* c_p of the step (NULL: cp) */
 } jst_params;
 sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
                                   sph_error *err);

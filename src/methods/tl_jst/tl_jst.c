@@ -3,7 +3,8 @@
  * conservation laws eq. 41 with the corrected gradient eq. 21, internal
  * force eq. 42 (or the symmetric force of seed 003 eq. 11), JST dissipation
  * on p and J only (eq. 35-38), angular momentum and JST projections
- * (eq. 45-51), monolithic TVD-RK2 (eq. 43) with dt from eq. 44, essential
+ * (eq. 45-51), monolithic TVD-RK2 (eq. 43; or the SSP-RK3 of seed 004
+ * eq. 30) with dt from eq. 44, essential
  * boundary conditions imposed on particles. */
 #include <math.h>
 #include <stdlib.h>
@@ -154,9 +155,10 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_ext);
   m->sweep(m, n);
-  /* X^chi of eq. 45: x^n, then x^n + dt / (2 rho0) (p^n + p*) */
+  /* X^chi of eq. 45: x^n, then x^n + dt / (2 rho0) (p^n + p*) for
+   * TVD-RK2; SSP-RK3 takes the stage's x (no exact angular momentum) */
   const double *xm = m->x;
-  if (stage > 0) {
+  if (stage > 0 && m->integrate == sph_tvd_rk2_step) {
 #pragma omp parallel for schedule(static)
     for (long a = 0; a < n; ++a)
       for (int c = 0; c < 3; ++c)
@@ -199,7 +201,7 @@ static double tl_jst_stable_dt(sph_sim *sim) {
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
   double s0 = m->ode.seconds;
-  SPH_TRY(sph_tvd_rk2_step(&m->ode, sim->t, dt, err));
+  SPH_TRY(m->integrate(&m->ode, sim->t, dt, err));
   double t0 = sph_wtime();
   sph_status st = tl_check_finite(&m->ref, err);
   sph_timer *tm = &sim->timers[m->timer_integration];
@@ -213,7 +215,7 @@ static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_ext);
   tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
-            m->fields == TL_JST_PF ? NULL : m->J);
+            m->fields == TL_JST_PF ? NULL : m->J, NULL);
   if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
     /* the rates are scratch between steps */
     SPH_TRY(tl_jst_rhs(m, 0, sim->t, 0.0, err));
@@ -290,7 +292,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   static const char *const forces[] = {"conservative", "symmetric", "eq30",
                                        "eq31", NULL};
   static const char *const laps[] = {"corrected", "gradient", NULL};
-  static const char *const integrators[] = {"tvd-rk2", NULL};
+  static const char *const integrators[] = {"tvd-rk2", "ssp-rk3", NULL};
   static const char *const bcs[] = {"direct", "lagrange", NULL};
   int f, fo, lp, integ, bc, amp, jproj;
   SPH_TRY(sph_node_get_choice(opt, "fields", fields, "pF", &f, err));
@@ -310,6 +312,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   int ws;
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "current", &ws, err));
   m->current_wave_speed = ws == 0;
+  m->integrate = integ == 1 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
   m->fields = (tl_jst_fields)f;
   m->force = (tl_jst_force)fo;
   SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
@@ -432,13 +435,27 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (amp)
     SPH_TRY(angular_momentum_projection_create(sim, err));
   if (need_p) {
-    jst_params jp = {m->ref.nl, m->lap,    m->ref.V, 3,    e2p,
-                     e4p,       m->ref.cp, sim->dp,  jproj};
+    jst_params jp = {.nl = m->ref.nl,
+                     .lap = m->lap,
+                     .V = m->ref.V,
+                     .ncomp = 3,
+                     .eps2 = e2p,
+                     .eps4 = e4p,
+                     .cp = m->ref.cp,
+                     .h = sim->dp,
+                     .project = jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (need_j) {
-    jst_params jp = {m->ref.nl, m->lap,    m->ref.V, 1,    e2j,
-                     e4j,       m->ref.cp, sim->dp,  jproj};
+    jst_params jp = {.nl = m->ref.nl,
+                     .lap = m->lap,
+                     .V = m->ref.V,
+                     .ncomp = 1,
+                     .eps2 = e2j,
+                     .eps4 = e4j,
+                     .cp = m->ref.cp,
+                     .h = sim->dp,
+                     .project = jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   if (s->has_body_force)
@@ -457,7 +474,6 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     /* the initial state honours the constraints */
     SPH_TRY(tl_jst_constrain(m, 0.0, err));
   }
-  (void)integ;
   return SPH_OK;
 }
 

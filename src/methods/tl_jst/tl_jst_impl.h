@@ -34,6 +34,7 @@ typedef struct tl_jst {
   double *P;       /* first Piola-Kirchhoff stress of the stage */
   double *xmoment; /* X^chi of seed 000 eq. 45 */
   sph_ode ode;
+  sph_rk_step integrate; /* TVD-RK2 or SSP-RK3 */
   int timer_force;
   int timer_integration; /* the integrator's updates, the finite check */
   struct sph_sim *sim;
