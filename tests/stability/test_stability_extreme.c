@@ -50,6 +50,46 @@ START_TEST(twisting_column_omega_300) {
 }
 END_TEST
 
+/* scenes/twisting_column_bond.yaml: the same column with seed 004's method
+ * (tl-bond, bond F, SSP-RK3 at CFL 0.5) as shipped (7 x 37 x 7) to its end
+ * time, the paper's 92.1 ms: stable through the twist peak and back; then
+ * on past it to 0.3 s, where the run must end with a verdict (it measures a
+ * time-step collapse at 0.138 s: two particles closing onto each other),
+ * never hang or NaN unnoticed. */
+START_TEST(twisting_column_bond_omega_300) {
+  tip_track tt = {0, 0.0};
+  outcome o = run_case("twisting_column_bond", NULL, 0, 0.0025, track_tip, &tt);
+  show("A3 tl-bond Omega 300 to 92.1 ms", &o, "tip moved %.3g m", tt.max_disp);
+  ck_assert_msg(o.stable, "%s", o.reason);
+  ck_assert_msg(o.j_min > 0.3, "J min %g", o.j_min);
+  ck_assert_msg(o.e_max <= o.e0 * 1.0001, "energy %g above the initial %g",
+                o.e_max, o.e0);
+  ck_assert_msg(tt.max_disp > 0.3, "tip moved only %g m", tt.max_disp);
+  const char *past[] = {"time.end=0.3"};
+  outcome p = run_case("twisting_column_bond", past, 1, 0.0025, NULL, NULL);
+  show("A3 tl-bond Omega 300 to 0.3 s", &p, "tripped at %.4g s", p.t_tripped);
+  ck_assert_msg(p.stable || p.t_tripped > 0.0921,
+                "tripped at %g s, before the paper's 92.1 ms", p.t_tripped);
+}
+END_TEST
+
+/* seed 004 sec. 5.3/5.5: SSP-RK3 with the bond F runs the shipped A1 column
+ * (7 x 37 x 7, to its end time 0.3 s) at CFL 0.9, where tl-jst's TVD-RK2
+ * at the same CFL is stopped; both at h = 1.1 dp (tl-bond's kernel) */
+START_TEST(twisting_column_cfl_09) {
+  const char *bond[] = {"method={name: tl-bond, cfl: 0.9}",
+                        "kernel.h_over_dp=1.1"};
+  outcome b = run_case("twisting_column", bond, 2, 0.005, NULL, NULL);
+  show("A1 tl-bond SSP-RK3 CFL 0.9", &b, NULL);
+  ck_assert_msg(b.stable, "%s", b.reason);
+  ck_assert_msg(b.e_max <= b.e0 * 1.0001, "energy %g above %g", b.e_max, b.e0);
+  const char *jst[] = {"method.cfl=0.9", "kernel.h_over_dp=1.1"};
+  outcome j = run_case("twisting_column", jst, 2, 0.005, NULL, NULL);
+  show("A1 tl-jst TVD-RK2 CFL 0.9", &j, "tripped at %.4g s", j.t_tripped);
+  ck_assert_msg(!j.stable, "tl-jst at CFL 0.9 was not flagged");
+}
+END_TEST
+
 /* ---- B10: pulling column --------------------------------------------------
  */
 
@@ -335,6 +375,8 @@ int main(void) {
   tcase_set_timeout(tc, 900);
   tcase_add_checked_fixture(tc, sph_test_enable_fp_traps, NULL);
   tcase_add_test(tc, twisting_column_omega_300);
+  tcase_add_test(tc, twisting_column_bond_omega_300);
+  tcase_add_test(tc, twisting_column_cfl_09);
   tcase_add_test(tc, pulling_column);
   tcase_add_test(tc, oscillating_plate_30_periods);
   tcase_add_test(tc, oscillating_plate_large_amplitude);
