@@ -26,7 +26,7 @@ rc=$?
 check "study exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'
 csv=$out/results.csv
 check "results.csv has a header and 4 rows" '[ "$(wc -l <"$csv")" -eq 5 ]'
-check "17 columns" '[ "$(ncols "$csv" 1)" -eq 17 ] && [ "$(ncols "$csv" 5)" -eq 17 ]'
+check "18 columns" '[ "$(ncols "$csv" 1)" -eq 18 ] && [ "$(ncols "$csv" 5)" -eq 18 ]'
 check "header" 'head -1 "$csv" | grep -q "^method.fields,bodies.0.particles.spacing,particles,dp,steps,wall_seconds,particle_steps_per_second,l2_velocity,l2_stress,l2_displacement,h1_displacement,period_error,period,energy_drift,linear_momentum_drift,angular_momentum_drift,stable,reason$"'
 check "rows in case order" '[ "$(cut -d, -f1,2 "$csv" | tail -4 | tr "\n" " ")" = "pF,0.25 pF,0.125 pFJ,0.25 pFJ,0.125 " ]'
 check "particles 64 and 512" '[ "$(field "$csv" 0 particles)" = 64 ] && [ "$(field "$csv" 1 particles)" = 512 ]'
