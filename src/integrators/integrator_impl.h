@@ -23,6 +23,12 @@ typedef struct sph_ode {
   double seconds; /* wall time of the integrator's own updates, summed */
 } sph_ode;
 
+/* Appends the state array y of len doubles, allocating its start-of-step
+ * copy and its rates (zeroed; *y0 and *rate receive them, the caller frees
+ * them). */
+sph_status sph_ode_add(sph_ode *ode, double *y, size_t len, double **y0,
+                       double **rate, sph_error *err);
+
 /* Two-stage TVD Runge-Kutta (seed 000 eq. 43):
  * u* = u^n + dt f(u^n); u** = u* + dt f(u*); u^{n+1} = (u^n + u**) / 2. */
 sph_status sph_tvd_rk2_step(sph_ode *ode, double t, double dt, sph_error *err);

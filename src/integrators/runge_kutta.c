@@ -3,6 +3,7 @@
  * the three-stage SSP-RK3 of seed 004 eq. 30. Each stage is a convex
  * combination y = a y^n + b (y + dt f(y)) of forward-Euler steps. */
 #include <omp.h>
+#include <stdlib.h>
 
 #include "integrators/integrator_impl.h"
 
@@ -64,4 +65,21 @@ sph_status sph_ssp_rk3_step(sph_ode *ode, double t, double dt, sph_error *err) {
   SPH_TRY(stage(ode, 1, t + dt, t + 0.5 * dt, 0.75, 0.25, dt, err));
   /* eq. 30c: U^{n+1} = 1/3 U^n + 2/3 (U** + dt R(U**)) */
   return stage(ode, 2, t + 0.5 * dt, t + dt, 1.0 / 3.0, 2.0 / 3.0, dt, err);
+}
+
+sph_status sph_ode_add(sph_ode *ode, double *y, size_t len, double **y0,
+                       double **rate, sph_error *err) {
+  if (ode->nvec == SPH_ODE_MAX)
+    return sph_error_set(err, SPH_ERR_ARG, "more than %d state arrays",
+                         SPH_ODE_MAX);
+  *y0 = calloc(len ? len : 1, sizeof **y0);
+  *rate = calloc(len ? len : 1, sizeof **rate);
+  if (!*y0 || !*rate)
+    return sph_error_set(err, SPH_ERR_NOMEM, "integrator arrays");
+  int v = ode->nvec++;
+  ode->y[v] = y;
+  ode->y0[v] = *y0;
+  ode->rate[v] = *rate;
+  ode->len[v] = len;
+  return SPH_OK;
 }

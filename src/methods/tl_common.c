@@ -764,3 +764,33 @@ sph_status tl_constrain_terms(sph_sim *sim, const tl_reference *ref, double t,
   sph_stage s = {.t = t, .x = ref->x, .p = ref->p, .F = ref->F};
   return sph_sim_terms_constrain(sim, &s, err);
 }
+
+sph_status tl_rk_step(sph_sim *sim, const tl_reference *ref, sph_ode *ode,
+                      sph_rk_step integrate, int timer, double dt,
+                      sph_error *err) {
+  double s0 = ode->seconds;
+  SPH_TRY(integrate(ode, sim->t, dt, err));
+  double t0 = sph_wtime();
+  sph_status st = tl_check_finite(ref, err);
+  sph_timer *tm = &sim->timers[timer];
+  tm->seconds += ode->seconds - s0 + sph_wtime() - t0;
+  tm->calls++;
+  return st;
+}
+
+sph_status tl_rk_acceleration(sph_sim *sim, const tl_reference *ref,
+                              sph_ode *ode, sph_error *err) {
+  if (!sim->ps->field[SPH_FIELD_ACCELERATION])
+    return SPH_OK;
+  /* the rates are scratch between steps; the momentum's are the second */
+  SPH_TRY(ode->rhs(ode->ctx, 0, sim->t, 0.0, err));
+  tl_acceleration(sim, ref, ode->rate[1]);
+  return SPH_OK;
+}
+
+int tl_state_xpF(const tl_reference *ref, sph_state_array *out) {
+  out[0] = (sph_state_array){"x", ref->x, 3 * ref->n};
+  out[1] = (sph_state_array){"p", ref->p, 3 * ref->n};
+  out[2] = (sph_state_array){"F", ref->F, 9 * ref->n};
+  return 3;
+}

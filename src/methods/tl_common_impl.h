@@ -186,6 +186,18 @@ tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
 sph_status tl_leapfrog_step(sph_sim *sim, const tl_reference *ref,
                             sph_leapfrog *lf, int timer, double dt,
                             sph_error *err);
+/* One Runge-Kutta step of ode and the finite-state check, their time added
+ * to the `timer` (time_integration). */
+sph_status tl_rk_step(sph_sim *sim, const tl_reference *ref, sph_ode *ode,
+                      sph_rk_step integrate, int timer, double dt,
+                      sph_error *err);
+/* The acceleration output field from ode's rates at the current state
+ * (x and p its first two arrays), when the scene asks for it. */
+sph_status tl_rk_acceleration(sph_sim *sim, const tl_reference *ref,
+                              sph_ode *ode, sph_error *err);
+/* The checkpointed state x, p and F of the real particles (method ops
+ * `state`): returns 3. */
+int tl_state_xpF(const tl_reference *ref, sph_state_array *out);
 sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
                               sph_leapfrog *lf, const double *dp,
                               sph_error *err);

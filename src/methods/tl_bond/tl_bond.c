@@ -102,23 +102,12 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
       m->dx[3 * a + c] = va[c];
     }
   }
-  sim->timers[m->timer_force].seconds += sph_wtime() - t0;
-  sim->timers[m->timer_force].calls++;
-  sph_stage s = {.t = t,
-                 .x = m->x,
-                 .p = m->p,
-                 .F = m->F,
-                 .x_moment = m->x,
-                 .dx = m->dx,
-                 .dp = m->dp,
-                 .dF = m->dF};
-  return sph_sim_terms_rates(sim, &s, err);
+  return tl_rates_terms(sim, ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status tl_bond_constrain(void *ctx, double t, sph_error *err) {
   tl_bond *m = ctx;
-  sph_stage s = {.t = t, .x = m->x, .p = m->p, .F = m->F};
-  return sph_sim_terms_constrain(m->sim, &s, err);
+  return tl_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 /* ---- ops
@@ -165,26 +154,15 @@ static double tl_bond_stable_dt(sph_sim *sim) {
 
 static sph_status tl_bond_step(sph_sim *sim, double dt, sph_error *err) {
   tl_bond *m = sim->method_data;
-  double s0 = m->ode.seconds;
-  SPH_TRY(m->integrate(&m->ode, sim->t, dt, err));
-  double t0 = sph_wtime();
-  sph_status st = tl_check_finite(&m->ref, err);
-  sph_timer *tm = &sim->timers[m->timer_integration];
-  tm->seconds += m->ode.seconds - s0 + sph_wtime() - t0;
-  tm->calls++;
-  return st;
+  return tl_rk_step(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
+                    dt, err);
 }
 
 static sph_status tl_bond_derive(sph_sim *sim, sph_error *err) {
   tl_bond *m = sim->method_data;
   const double *Fs = deformation_and_stress(m);
   tl_derive(sim, &m->ref, NULL, NULL, Fs);
-  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
-    /* the rates are scratch between steps */
-    SPH_TRY(tl_bond_rhs(m, 0, sim->t, 0.0, err));
-    tl_acceleration(sim, &m->ref, m->dp);
-  }
-  return SPH_OK;
+  return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
 
 /* strain energy at the F the stress is evaluated at */
@@ -367,20 +345,10 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");
 
   /* integrator storage */
-  size_t len[3] = {3 * n, 3 * n, 9 * n};
-  double *y[3] = {m->x, m->p, m->F};
-  double **y0[3] = {&m->x0, &m->p0, &m->F0};
-  double **r[3] = {&m->dx, &m->dp, &m->dF};
   sph_ode *ode = &m->ode;
-  for (int i = 0; i < 3; ++i) {
-    SPH_TRY(alloc_zero(y0[i], len[i], err));
-    SPH_TRY(alloc_zero(r[i], len[i], err));
-    ode->y[i] = y[i];
-    ode->y0[i] = *y0[i];
-    ode->rate[i] = *r[i];
-    ode->len[i] = len[i];
-  }
-  ode->nvec = 3;
+  SPH_TRY(sph_ode_add(ode, m->x, 3 * n, &m->x0, &m->dx, err));
+  SPH_TRY(sph_ode_add(ode, m->p, 3 * n, &m->p0, &m->dp, err));
+  SPH_TRY(sph_ode_add(ode, m->F, 9 * n, &m->F0, &m->dF, err));
   ode->rhs = tl_bond_rhs;
   ode->constrain = tl_bond_constrain;
   ode->ctx = m;
@@ -411,11 +379,7 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 
 static int tl_bond_state(sph_sim *sim, sph_state_array *out) {
   tl_bond *m = sim->method_data;
-  size_t n = m->ref.n;
-  out[0] = (sph_state_array){"x", m->x, 3 * n};
-  out[1] = (sph_state_array){"p", m->p, 3 * n};
-  out[2] = (sph_state_array){"F", m->F, 9 * n};
-  return 3;
+  return tl_state_xpF(&m->ref, out);
 }
 
 const sph_method_ops tl_bond_method_ops = {

@@ -122,12 +122,8 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 
 static int tl_csph_state(sph_sim *sim, sph_state_array *out) {
   tl_csph *m = sim->method_data;
-  size_t n = m->ref.n;
-  out[0] = (sph_state_array){"x", m->x, 3 * n};
-  out[1] = (sph_state_array){"p", m->p, 3 * n};
   /* F of the last rates: the next time step's wave speed reads it */
-  out[2] = (sph_state_array){"F", m->F, 9 * n};
-  return 3;
+  return tl_state_xpF(&m->ref, out);
 }
 
 const sph_method_ops tl_csph_method_ops = {

@@ -200,14 +200,8 @@ static double tl_jst_stable_dt(sph_sim *sim) {
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
-  double s0 = m->ode.seconds;
-  SPH_TRY(m->integrate(&m->ode, sim->t, dt, err));
-  double t0 = sph_wtime();
-  sph_status st = tl_check_finite(&m->ref, err);
-  sph_timer *tm = &sim->timers[m->timer_integration];
-  tm->seconds += m->ode.seconds - s0 + sph_wtime() - t0;
-  tm->calls++;
-  return st;
+  return tl_rk_step(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
+                    dt, err);
 }
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
@@ -216,12 +210,7 @@ static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   compute_stress(m, (long)m->ref.n_ext);
   tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
             m->fields == TL_JST_PF ? NULL : m->J, NULL);
-  if (sim->ps->field[SPH_FIELD_ACCELERATION]) {
-    /* the rates are scratch between steps */
-    SPH_TRY(tl_jst_rhs(m, 0, sim->t, 0.0, err));
-    tl_acceleration(sim, &m->ref, m->dp);
-  }
-  return SPH_OK;
+  return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
 
 static void tl_jst_energy(sph_sim *sim, double *kinetic, double *strain) {
@@ -415,17 +404,9 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   double **r[5] = {&m->dx, &m->dp, &m->dF, &m->dH, &m->dJ};
   int use[5] = {1, 1, 1, m->fields == TL_JST_PFHJ, m->fields != TL_JST_PF};
   sph_ode *ode = &m->ode;
-  for (int i = 0; i < 5; ++i) {
-    if (!use[i])
-      continue;
-    SPH_TRY(alloc_zero(y0[i], len[i], err));
-    SPH_TRY(alloc_zero(r[i], len[i], err));
-    ode->y[ode->nvec] = *y[i];
-    ode->y0[ode->nvec] = *y0[i];
-    ode->rate[ode->nvec] = *r[i];
-    ode->len[ode->nvec] = len[i];
-    ode->nvec++;
-  }
+  for (int i = 0; i < 5; ++i)
+    if (use[i])
+      SPH_TRY(sph_ode_add(ode, *y[i], len[i], y0[i], r[i], err));
   SPH_TRY(alloc_zero(&m->xmoment, 3 * n, err));
   ode->rhs = tl_jst_rhs;
   ode->constrain = tl_jst_constrain;
