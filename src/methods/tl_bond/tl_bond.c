@@ -82,19 +82,19 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
   (void)stage;
   (void)dt;
   deformation_and_stress(m);
+  long ne = (long)ref->n_ext;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a)
+    for (int c = 0; c < 3; ++c)
+      m->v[3 * a + c] = m->p[3 * a + c] / ref->rho0[a];
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double dF[9] = {0}, dp[3] = {0, 0, 0}, va[3];
-    const double *Pa = m->P + 9 * a;
-    for (int c = 0; c < 3; ++c)
-      va[c] = m->p[3 * a + c] / ref->rho0[a];
+    double dF[9] = {0}, dp[3] = {0, 0, 0};
+    const double *Pa = m->P + 9 * a, *va = m->v + 3 * a;
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      double vb[3];
-      for (int c = 0; c < 3; ++c)
-        vb[c] = m->p[3 * b + c] / ref->rho0[b];
-      tl_bond_iact_rates(dF, dp, va, vb, Pa, m->P + 9 * b, m->gv + 3 * k,
-                         m->fa + 3 * k, m->fb + 3 * k);
+      tl_bond_iact_rates(dF, dp, va, m->v + 3 * b, Pa, m->P + 9 * b,
+                         m->gv + 3 * k, m->fa + 3 * k, m->fb + 3 * k);
     }
     memcpy(m->dF + 9 * a, dF, sizeof dF);
     for (int c = 0; c < 3; ++c) {
@@ -142,8 +142,9 @@ static double tl_bond_stable_dt(sph_sim *sim) {
       size_t b = (size_t)nl->index[k];
       double la = m->pair_speed ? m->lam[a] : 1.0;
       double lb = m->pair_speed ? m->lam[b] : 1.0;
-      tmin = fmin(tmin, tl_bond_iact_transit(m->x + 3 * a, m->x + 3 * b, la, lb,
-                                             ref->cp));
+      double ts =
+          tl_bond_iact_transit(m->x + 3 * a, m->x + 3 * b, la, lb, ref->cp);
+      tmin = ts < tmin ? ts : tmin;
     }
   /* the JST's c_p: the fastest pair speed of the step */
   m->cp_now = ref->cp / fmax(lam_min, 1e-12);
@@ -335,6 +336,7 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     SPH_TRY(alloc_zero(&m->lap_sym, count, err));
   }
   SPH_TRY(alloc_zero(&m->Mc, 9 * ne, err));
+  SPH_TRY(alloc_zero(&m->v, 3 * ne, err));
   if (m->bond)
     SPH_TRY(alloc_zero(&m->Fc, 9 * ne, err));
   if (m->pair_speed)

@@ -25,6 +25,7 @@ typedef struct tl_bond {
   double *Mc;  /* I - sum_b (X_b - X_a) (x) q_ab, 9 each */
   double *Fc;  /* the F the stress is evaluated at, 9 each */
   double *lam; /* smallest principal stretch (eq. 32) */
+  double *v;   /* velocity p / rho0 of the stage */
   /* state (x, p, F: the reference's arrays), RK copies and rates */
   double *x, *p, *F, *P;
   double *x0, *p0, *F0;
