@@ -19,7 +19,7 @@ assert b["schema_version"] == 1 and b["suite"] == "quick", b
 assert b["machine"]["cores"] >= 1 and b["machine"]["cpu"], b["machine"]
 cases = b["cases"]
 names = {c["name"] for c in cases}
-assert len(names) == 8, names
+assert len(names) == 9, names
 threads = {c["threads"] for c in cases}
 assert 1 in threads, threads
 for c in cases:
