@@ -7,7 +7,8 @@
 #    steps, wall time;
 #  - on the B6 swinging plate (scenes/swinging_plate_2d.yaml, linear
 #    elastic: the exact solution's material) at d = 0.1 and 0.05: L2 and H1
-#    displacement errors, wall time.
+#    displacement errors, wall time;
+#  - B8 and B10 below.
 # Each writes results.csv, report.md and plots under outputs/. Extra
 # options pass through to sph study (--threads N, --repeat N, --resume,
 # --dry-run).
@@ -28,3 +29,19 @@ plate='{name: tl-jst, fields: pF, jst: {eps2_p: 0, eps4_p: 0.125}, integrator: t
   --vary method.cfl=0.3,0.6,0.9 \
   --vary bodies.0.particles.spacing=0.1,0.05 \
   --out outputs/tl_bond_swinging_plate "$@"
+# B8 column energy (seed 004 sec. 5.3: about 1 % lost) and B10 pulling
+# column (sec. 5.4: stretch at the first NaN; here the time the verdict
+# stops the run, stretch = 10 t / 6 x 100 %, with the fracture indicator
+# off as the paper's criterion is a NaN), tl-bond at h = 1.1 dp
+bond='{name: tl-bond, jst: {eps2_p: 0, eps4_p: 0.125}},{name: tl-bond, jst: {eps2_p: 0, eps4_p: 0.125}, correction: zeroth_order}'
+"$sph" study scenes/column_energy.yaml \
+  --set kernel.h_over_dp=1.1 --set output.png=false \
+  --vary "method={name: tl-jst, fields: pF, jst: {eps2_p: 0, eps4_p: 0.125}, cfl: 0.3},$bond" \
+  --out outputs/tl_bond_column_energy "$@"
+pull='{name: tl-bond, jst: {eps2_p: 0, eps4_p: 0.015625}},{name: tl-bond, jst: {eps2_p: 0, eps4_p: 0.015625}, correction: zeroth_order}'
+"$sph" study scenes/pulling_column.yaml \
+  --set kernel.h_over_dp=1.1 --set time.end=3 --set stability.fracture_dp=100 \
+  --set output.png=false --set output.vtk=false \
+  --vary "method={name: tl-jst, fields: pF, jst: {eps2_p: 0, eps4_p: 0.015625}, cfl: 0.3},$pull" \
+  --vary materials.rubber.poisson_ratio=0.45,0.495 \
+  --out outputs/tl_bond_pulling_column "$@"
