@@ -182,9 +182,9 @@ static void tl_bond_destroy(sph_sim *sim) {
   if (!m)
     return;
   tl_reference_destroy(&m->ref);
-  double *arrays[] = {m->gv,      m->fa, m->fb, m->q,   m->lap,
-                      m->lap_sym, m->Mc, m->Fc, m->lam, m->x0,
-                      m->p0,      m->F0, m->dx, m->dp,  m->dF};
+  double *arrays[] = {m->v,       m->gv, m->fa, m->fb,  m->q,  m->lap,
+                      m->lap_sym, m->Mc, m->Fc, m->lam, m->x0, m->p0,
+                      m->F0,      m->dx, m->dp, m->dF};
   for (size_t i = 0; i < sizeof arrays / sizeof *arrays; ++i)
     free(arrays[i]);
   free(m);
