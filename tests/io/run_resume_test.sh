@@ -29,9 +29,15 @@ same_run() { # uninterrupted dir, resumed dir, scene name
   done
   [ ! -f "$a/probes.csv" ] || cmp -s "$a/probes.csv" "$b/probes.csv" ||
     fail "probes.csv differs after resume"
-  # summary numbers (not wall times)
-  for key in steps dt_min dt_max energy J linear_momentum_drift angular_momentum_drift \
-    fracture zigzag_max stable error; do
+  # summary numbers (not wall times), and how often each part ran (issue
+  # 21: the call counts are in the checkpoint); leap-frog methods evaluate
+  # their rates once more after a resume (the rates of the last step are
+  # not part of the method's checkpointed state): calls_warm=1 leaves their
+  # counts out
+  local keys=(steps dt_min dt_max energy J linear_momentum_drift angular_momentum_drift
+    fracture zigzag_max stable error)
+  [ "${calls_warm:-0}" = 1 ] || keys+=(calls)
+  for key in "${keys[@]}"; do
     [ "$(grep "\"$key\"" "$a/summary.json")" = "$(grep "\"$key\"" "$b/summary.json")" ] ||
       fail "summary.json $key differs after resume"
   done
@@ -65,11 +71,11 @@ kill_and_resume() { # label, scene name, end, checkpoint interval, --set options
 kill_and_resume tl-jst twisting_column 0.3 0.02
 # tl-csph (no stabilisation) fractures at 0.175 s at the shipped 7 x 37 x 7
 # (3.07 dp): resumed at 5 x 25 x 5, where it stays stable to 0.3 s
-kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}' \
+calls_warm=1 kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}' \
   --set 'bodies.0.particles.count=[5,25,5]'
 # ul-csph: the reference x^r, F^r and the steps since the update are state;
 # neighbours, corrections and the stabilisation are rebuilt from them
-kill_and_resume ul-csph bending_cylinder_ul_csph 0.3 0.05
+calls_warm=1 kill_and_resume ul-csph bending_cylinder_ul_csph 0.3 0.05
 # ul-sph: the configuration (neighbours, pair geometry) is rebuilt from the
 # checkpoint's positions of the last update
 kill_and_resume ul-sph colliding_rings 0.006 0.0005 \
