@@ -90,6 +90,10 @@ int sph_app_parse_args(int argc, char **argv, sph_app_args *args,
 /* The shipped scenes folder and the default scene. */
 /* mkdir -p: 0, or -1 with errno set */
 int sph_app_mkdir_p(const char *path);
+/* An output folder made when missing (parents too) and tried by writing a
+ * file in it: SPH_OK, or SPH_ERR_ARG (exit 2) naming the folder, the same
+ * whether it cannot be made or exists and cannot be written in. */
+sph_status sph_app_output_dir(const char *dir, sph_error *err);
 
 const char *sph_app_scenes_dir(void);
 const char *sph_app_default_scene(void);

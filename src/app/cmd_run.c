@@ -311,29 +311,26 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  struct stat dst;
-  int made = sph_app_mkdir_p(dir) == 0 && stat(dir, &dst) == 0;
-  if (!made || !S_ISDIR(dst.st_mode)) {
-    fprintf(stderr, "sph: cannot create the output folder %s: %s\n", dir,
-            made ? "a file of that name exists" : strerror(errno));
-    sph_sim_destroy(sim);
-    sph_scene_destroy(scene);
-    return SPH_EXIT_IO;
-  }
-  long holder;
-  int lock_fd = lock_output(dir, &holder);
-  if (lock_fd < 0) {
+  /* a folder that cannot be made or written in: exit 2 either way */
+  long holder = 0;
+  int lock_fd = -1;
+  st = sph_app_output_dir(dir, &err);
+  if (st == SPH_OK && (lock_fd = lock_output(dir, &holder)) < 0) {
     if (holder > 0)
-      fprintf(stderr,
-              "sph: %s is in use by another sph run (pid %ld); wait for it "
-              "or write elsewhere with --out DIR\n",
-              dir, holder);
+      st = sph_error_set(&err, SPH_ERR_ARG,
+                         "%s is in use by another sph run (pid %ld); wait for "
+                         "it or write elsewhere with --out DIR",
+                         dir, holder);
     else
-      fprintf(stderr, "sph: cannot lock the output folder %s: %s\n", dir,
-              strerror(errno));
+      st = sph_error_set(&err, SPH_ERR_ARG,
+                         "cannot write in the output folder %s: %s", dir,
+                         strerror(errno));
+  }
+  if (st != SPH_OK) {
+    sph_app_print_error(&err);
     sph_sim_destroy(sim);
     sph_scene_destroy(scene);
-    return holder > 0 ? SPH_EXIT_USAGE : SPH_EXIT_IO;
+    return SPH_EXIT_USAGE;
   }
   if (args.overwrite && !args.resume)
     remove_previous(dir, scene->name);
