@@ -49,14 +49,18 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
          peak_rss_mib(), (double)sph_particles_bytes(ps) / 1048576.0);
 }
 
-static const int check_allowed[] = {SPH_OPT_SET, SPH_OPT_KEYS, 0};
+static const int check_allowed[] = {SPH_OPT_SET, SPH_OPT_KEYS,
+                                    SPH_OPT_MAX_MEMORY, 0};
 static const sph_app_command check_command = {
     "check",
-    "usage: sph check SCENE [--set key=value]... [--keys]\n"
+    "usage: sph check SCENE [--set key=value]... [--keys] [--max-memory "
+    "SIZE]\n"
     "  validate SCENE (a file or a shipped scene's name) and print what a\n"
     "  run would simulate: bodies, method, terms, time step, memory;\n"
     "  --keys: every key the scene has, defaults filled in, as --set writes\n"
-    "  it (bodies.0.particles.count), one per line\n",
+    "  it (bodies.0.particles.count), one per line; --max-memory: refuse a\n"
+    "  scene estimated to need more than SIZE (4G, 512M; default 90 % of\n"
+    "  the memory available)\n",
     check_allowed, NULL, NULL};
 
 /* --keys: the resolved tree's key paths in --set's form ([k] -> .k) */

@@ -187,20 +187,18 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
   return st;
 }
 
-static const int run_allowed[] = {SPH_OPT_SET,
-                                  SPH_OPT_OUT,
-                                  SPH_OPT_THREADS,
-                                  SPH_OPT_RESUME_DIR,
-                                  SPH_OPT_OVERWRITE,
-                                  SPH_OPT_QUIET,
-                                  0};
+static const int run_allowed[] = {
+    SPH_OPT_SET,       SPH_OPT_OUT,   SPH_OPT_THREADS,    SPH_OPT_RESUME_DIR,
+    SPH_OPT_OVERWRITE, SPH_OPT_QUIET, SPH_OPT_MAX_MEMORY, 0};
 static const sph_app_command run_command = {
     "run",
     "usage: sph run [SCENE] [--set key=value]... [--out DIR] [--threads N]\n"
-    "               [--overwrite] [--quiet] [--resume DIR]\n"
+    "               [--overwrite] [--quiet] [--resume DIR] [--max-memory "
+    "SIZE]\n"
     "  simulate SCENE (a file, or a shipped scene's name: sph list; default\n"
     "  twisting_column) to its end time; exit 0 stable, 1 unstable, 2 bad\n"
-    "  input or usage, 3 I/O failure\n",
+    "  input or usage, 3 I/O failure; a run estimated to need more than\n"
+    "  SIZE (4G, 512M; default 90 % of the memory available) is refused\n",
     run_allowed, NULL, NULL};
 
 /* SIGINT, SIGTERM, SIGHUP: the first asks the run to stop at the next step

@@ -223,6 +223,8 @@ static int args_option(void *ctx, int id, const char *val) {
   case SPH_OPT_KEYS:
     args->keys = 1;
     return SPH_EXIT_OK;
+  case SPH_OPT_MAX_MEMORY:
+    return sph_app_bytes(val, &args->max_memory);
   default:
     return SPH_EXIT_USAGE;
   }
@@ -259,20 +261,10 @@ int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
                  sph_sim **sim) {
   sph_error err;
   sph_error_clear(&err);
-  *scene = NULL;
-  *sim = NULL;
-  sph_status st = sph_scene_load(scene, path, args->sets, args->nsets, &err);
-  if (st == SPH_OK)
-    st = sph_sim_create(sim, *scene, &err);
-  if (st == SPH_OK)
-    st = sph_png_check(*sim, &err);
-  if (st == SPH_OK)
+  if (sph_app_check_scene(path, args->sets, args->nsets, args->max_memory,
+                          scene, sim, &err) == SPH_OK)
     return SPH_EXIT_OK;
-  sph_sim_destroy(*sim);
-  *sim = NULL;
   sph_app_print_error(&err);
-  sph_scene_destroy(*scene);
-  *scene = NULL;
   return SPH_EXIT_USAGE;
 }
 

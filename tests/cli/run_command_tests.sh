@@ -185,6 +185,15 @@ rc=$?
   --set 'bodies.0.particles.count=[300,300,300]' 2>"$work/stderr" >/dev/null
 [ $? -eq 2 ] && grep -q "GB of memory is available" "$work/stderr" && ok ||
   bad "oversized run: $(cat "$work/stderr")"
+# or above --max-memory: the punch (693 particles) needs about 2 MB
+"$sph" check punch --max-memory 1M 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "the limit (--max-memory) is 0.001 GB" "$work/stderr" && ok ||
+  bad "--max-memory 1M: $(cat "$work/stderr")"
+"$sph" run punch --max-memory 1M --out "$work/mm" 2>/dev/null >/dev/null
+[ $? -eq 2 ] && [ ! -e "$work/mm" ] && ok || bad "run --max-memory 1M"
+"$sph" check punch --max-memory 5M >/dev/null 2>&1 && ok || bad "--max-memory 5M"
+"$sph" check punch --max-memory 5X 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "max-memory takes a size" "$work/stderr" && ok || bad "--max-memory 5X"
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
