@@ -30,6 +30,7 @@ typedef struct sph_app_args {
   int overwrite;      /* --overwrite */
   int quiet;          /* --quiet */
   int keys;           /* check --keys */
+  int resolved;       /* check --resolved */
   double max_memory;  /* --max-memory BYTES (0: the memory available) */
 } sph_app_args;
 
@@ -60,7 +61,8 @@ enum {
   SPH_OPT_HEIGHT,
   SPH_OPT_MP4,
   SPH_OPT_KEYS,
-  SPH_OPT_MAX_MEMORY
+  SPH_OPT_MAX_MEMORY,
+  SPH_OPT_RESOLVED
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows

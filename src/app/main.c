@@ -223,6 +223,9 @@ static int args_option(void *ctx, int id, const char *val) {
   case SPH_OPT_KEYS:
     args->keys = 1;
     return SPH_EXIT_OK;
+  case SPH_OPT_RESOLVED:
+    args->resolved = 1;
+    return SPH_EXIT_OK;
   case SPH_OPT_MAX_MEMORY:
     return sph_app_bytes(val, &args->max_memory);
   default:

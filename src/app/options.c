@@ -36,6 +36,7 @@ static const struct option all_options[] = {
     {"mp4", no_argument, NULL, SPH_OPT_MP4},
     {"keys", no_argument, NULL, SPH_OPT_KEYS},
     {"max-memory", required_argument, NULL, SPH_OPT_MAX_MEMORY},
+    {"resolved", no_argument, NULL, SPH_OPT_RESOLVED},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 

@@ -664,11 +664,12 @@ sph_status sph_node_get_double(sph_node *map, const char *key, int required,
   SPH_TRY(lookup(map, key, required, &c, err));
   if (c)
     return sph_node_as_double(c, out, err);
+  *out = def;
+  if (!isfinite(def)) /* "none" (NAN): a scene cannot give it, so the */
+    return SPH_OK;    /* resolved tree leaves the key out to load back */
   char buf[40];
   format_double(def, buf, sizeof buf);
-  SPH_TRY(insert_scalar(map, key, buf, &c, err));
-  *out = def;
-  return SPH_OK;
+  return insert_scalar(map, key, buf, &c, err);
 }
 
 sph_status sph_node_get_int(sph_node *map, const char *key, int required,
