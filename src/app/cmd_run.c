@@ -298,17 +298,6 @@ int sph_cmd_run(int argc, char **argv) {
     snprintf(dir, sizeof dir, "%s", args.out);
   else
     snprintf(dir, sizeof dir, "outputs/%s", scene->name);
-  if ((file_exists(dir, "summary.json") ||
-       file_exists(dir, "scene_used.yaml")) &&
-      !args.overwrite && !args.resume) {
-    fprintf(stderr,
-            "sph: %s holds the results of an earlier run; pass --overwrite "
-            "to replace them or --out DIR to write elsewhere\n",
-            dir);
-    sph_sim_destroy(sim);
-    sph_scene_destroy(scene);
-    return SPH_EXIT_USAGE;
-  }
   /* a folder that cannot be made or written in: exit 2 either way */
   long holder = 0;
   int lock_fd = -1;
@@ -324,8 +313,18 @@ int sph_cmd_run(int argc, char **argv) {
                          "cannot write in the output folder %s: %s", dir,
                          strerror(errno));
   }
+  /* after the lock: a folder in use says so, whatever it holds */
+  if (st == SPH_OK && !args.overwrite && !args.resume &&
+      (file_exists(dir, "summary.json") || file_exists(dir, "scene_used.yaml")))
+    st = sph_error_set(&err, SPH_ERR_ARG,
+                       "%s holds the results of an earlier run; pass "
+                       "--overwrite to replace them or --out DIR to write "
+                       "elsewhere",
+                       dir);
   if (st != SPH_OK) {
     sph_app_print_error(&err);
+    if (lock_fd >= 0)
+      close(lock_fd);
     sph_sim_destroy(sim);
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;

@@ -23,13 +23,14 @@ if [ -z "$cc" ]; then
   echo "run_fuzz.sh: clang not found (./bootstrap.sh --with-fuzz installs it)" >&2
   exit 2
 fi
-cmake -S "$src" -B "$build" -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DSPH_FUZZ=ON -DSPH_BUILD_TESTS=OFF >"$build.configure.log" 2>&1 ||
-  { cat "$build.configure.log" >&2; exit 2; }
-cmake --build "$build" -j2 --target fuzz_scene >"$build.build.log" 2>&1 ||
-  { tail -40 "$build.build.log" >&2; exit 2; }
-fuzz=$build/tests/fuzz/fuzz_scene
 out=$build/fuzz
+mkdir -p "$out"
+cmake -S "$src" -B "$build" -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DSPH_FUZZ=ON -DSPH_BUILD_TESTS=OFF >"$out/configure.log" 2>&1 ||
+  { cat "$out/configure.log" >&2; exit 2; }
+cmake --build "$build" -j2 --target fuzz_scene >"$out/build.log" 2>&1 ||
+  { tail -40 "$out/build.log" >&2; exit 2; }
+fuzz=$build/tests/fuzz/fuzz_scene
 rm -rf "$out/seeds"
 mkdir -p "$out/seeds" "$out/corpus" "$out/artifacts"
 cp "$src"/scenes/*.yaml "$src"/tests/cli/bad/* "$out/seeds/"

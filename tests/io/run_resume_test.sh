@@ -16,33 +16,10 @@ scene=$src/scenes/twisting_column.yaml
 check=(/usr/bin/python3 "$(dirname "$0")/check_vtk.py")
 fails=0
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-
-same_run() { # uninterrupted dir, resumed dir, scene name
-  local a=$1 b=$2 name=$3 n=0
-  for f in "$a"/*.vtp; do
-    n=$((n + 1))
-    cmp -s "$f" "$b/$(basename "$f")" || fail "$(basename "$f") differs after resume"
-  done
-  [ "$(ls "$b"/*.vtp | wc -l)" -eq "$n" ] || fail "resumed run wrote a different number of frames"
-  for f in energy.csv "$name.pvd"; do
-    cmp -s "$a/$f" "$b/$f" || fail "$f differs after resume"
-  done
-  [ ! -f "$a/probes.csv" ] || cmp -s "$a/probes.csv" "$b/probes.csv" ||
-    fail "probes.csv differs after resume"
-  # summary numbers (not wall times), and how often each part ran (issue
-  # 21: the call counts are in the checkpoint); leap-frog methods evaluate
-  # their rates once more after a resume (the rates of the last step are
-  # not part of the method's checkpointed state): calls_warm=1 leaves their
-  # counts out
-  local keys=(steps dt_min dt_max energy J linear_momentum_drift angular_momentum_drift
-    fracture zigzag_max stable error)
-  [ "${calls_warm:-0}" = 1 ] || keys+=(calls)
-  for key in "${keys[@]}"; do
-    [ "$(grep "\"$key\"" "$a/summary.json")" = "$(grep "\"$key\"" "$b/summary.json")" ] ||
-      fail "summary.json $key differs after resume"
-  done
-  echo "  compared $n frames"
-}
+bad() { fail "$@"; }
+# same_run: every file and summary number of a resumed run as an
+# uninterrupted one's (calls_warm=1: not the call counts)
+. "$(dirname "$0")/compare_runs.sh"
 
 kill_and_resume() { # label, scene name, end, checkpoint interval, --set options...
   local label=$1 name=$2 end=$3 every=$4
