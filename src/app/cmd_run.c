@@ -301,7 +301,12 @@ int sph_cmd_run(int argc, char **argv) {
   /* a folder that cannot be made or written in: exit 2 either way */
   long holder = 0;
   int lock_fd = -1;
-  st = sph_app_output_dir(dir, &err);
+  struct stat rst;
+  if (args.resume && stat(dir, &rst) != 0) /* not made for a resume */
+    st = sph_error_set(&err, SPH_ERR_ARG, "nothing to resume in %s: %s", dir,
+                       strerror(errno));
+  else
+    st = sph_app_output_dir(dir, &err);
   if (st == SPH_OK && (lock_fd = lock_output(dir, &holder)) < 0) {
     if (holder > 0)
       st = sph_error_set(&err, SPH_ERR_ARG,

@@ -47,9 +47,10 @@ export GOMP_SPINCOUNT=1000 OMP_NUM_THREADS=1
   { tail -60 "$out/regressions.log" >&2; echo "run_fuzz.sh: a regression input crashes again" >&2; exit 1; }
 echo "fuzz: ${#regressions[@]} regression inputs replayed"
 
-# -timeout: one input may take 10 s (sanitizers, up to 64 MB of particles);
-# -max_len: scenes are a few kB
-args=(-max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -max_len=16384
+# -timeout: one input may take 30 s (the sanitizers slow the particle
+# generation 20-fold; the shipped rings' relaxation takes 6 s); -max_len:
+# scenes are a few kB
+args=(-max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -max_len=16384
   -dict="$src/tests/fuzz/scene.dict" -artifact_prefix="$out/artifacts/"
   -print_final_stats=1)
 [ "$jobs" -gt 1 ] && args+=(-jobs="$jobs" -workers="$jobs")

@@ -2,6 +2,11 @@
 # function): what a stopped run kept, and a finished run against an
 # uninterrupted one.
 
+# the fault tests' run: a twisting column of 3 x 7 x 3 particles to 0.3 s
+# (61 outputs, about 600 steps, well under a second)
+scene=twisting_column
+small=(--threads 1 --quiet --set 'bodies.0.particles.count=[3,7,3]' --set time.end=0.3)
+
 # kept_run STOPPED REFERENCE NAME: what a run stopped by a failure or a
 # signal left: no temporary (.part) file (parts_ok=1: a run killed with
 # SIGKILL may leave them), every frame (.vtp, frames/*.png) identical to the

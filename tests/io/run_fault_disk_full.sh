@@ -14,9 +14,7 @@ set -u
 sph=$1
 src=$2
 . "$src/tests/cli/harness.sh"
-. "$(dirname "$0")/compare_runs.sh"
-scene=twisting_column
-base=(--threads 1 --quiet --set 'bodies.0.particles.count=[3,7,3]' --set time.end=0.3)
+. "$(dirname "$0")/compare_runs.sh" # scene, small: the run
 
 ns=(unshare --mount --propagation private)
 [ "$(id -u)" -eq 0 ] || ns=(unshare --user --map-root-user --mount --propagation private)
@@ -48,7 +46,7 @@ full_then_resume() { # mount size out snap done -- sph run args...
 fill() {
   local kind=$1 where=$2 regex=$3 sweep=$4
   shift 5
-  local args=("${base[@]}" "$@") ref=$work/$kind-ref
+  local args=("${small[@]}" "$@") ref=$work/$kind-ref
   "$sph" run $scene --out "$ref" "${args[@]}" >/dev/null || { bad "$kind: uninterrupted run"; return; }
   local used
   used=$(du -sk "$ref/$([ "$where" = frames ] && echo frames)" | cut -f1)

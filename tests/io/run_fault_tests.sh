@@ -12,9 +12,7 @@ set -u
 sph=$1
 src=$2
 . "$src/tests/cli/harness.sh"
-. "$(dirname "$0")/compare_runs.sh"
-scene=twisting_column
-small=(--threads 1 --quiet --set 'bodies.0.particles.count=[3,7,3]' --set time.end=0.3)
+. "$(dirname "$0")/compare_runs.sh" # scene, small: the run
 
 reference() { # dir, run args...
   local d=$1

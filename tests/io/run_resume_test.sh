@@ -12,14 +12,14 @@ sph=$1
 src=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# same_run: every file and summary number of a resumed run as an
+# uninterrupted one's (calls_warm=1: not the call counts)
+. "$(dirname "$0")/compare_runs.sh"
 scene=$src/scenes/twisting_column.yaml
 check=(/usr/bin/python3 "$(dirname "$0")/check_vtk.py")
 fails=0
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 bad() { fail "$@"; }
-# same_run: every file and summary number of a resumed run as an
-# uninterrupted one's (calls_warm=1: not the call counts)
-. "$(dirname "$0")/compare_runs.sh"
 
 kill_and_resume() { # label, scene name, end, checkpoint interval, --set options...
   local label=$1 name=$2 end=$3 every=$4
@@ -87,7 +87,8 @@ rc=$?
 [ $rc -eq 2 ] || fail "other configuration: exit $rc"
 echo "$out" | grep -q "different configuration" || fail "other configuration: message '$out'"
 out=$("$sph" run "$scene" --resume "$work/nowhere" --quiet 2>&1)
-[ $? -eq 2 ] || fail "missing checkpoint accepted"
+[ $? -eq 2 ] && echo "$out" | grep -q "nothing to resume in $work/nowhere" || fail "missing folder resumed: $out"
+[ ! -e "$work/nowhere" ] || fail "--resume made the missing folder"
 echo "refusals: checked"
 
 # a write failure mid-run (file size limit as a full disk): energy.csv
