@@ -55,15 +55,20 @@ args=(-max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -max_len=16384
   -print_final_stats=1)
 [ "$jobs" -gt 1 ] && args+=(-jobs="$jobs" -workers="$jobs")
 set +e
-"$fuzz" "${args[@]}" "$out/corpus" "$out/seeds" >"$out/fuzz.log" 2>&1
+rm -f "$out"/fuzz-*.log
+# with -jobs each worker logs to fuzz-N.log in the working folder
+(cd "$out" && "$fuzz" "${args[@]}" "$out/corpus" "$out/seeds") >"$out/fuzz.log" 2>&1
 rc=$?
 set -e
-execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/fuzz.log" | tail -1)
-rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$out/fuzz.log" | tail -1)
+for f in "$out"/fuzz-*.log; do
+  [ -f "$f" ] && cat "$f" >>"$out/fuzz.log"
+done
+execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/fuzz.log" | awk '{s += $1} END {print s}')
+rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$out/fuzz.log" | awk '{s += $1} END {print s}')
 echo "fuzz: ${execs:-?} inputs in ${secs} s (${rate:-?} exec/s), corpus $(ls "$out/corpus" | wc -l) files; log $out/fuzz.log"
-if [ $rc -ne 0 ]; then
+found=$(sed -n "s/.*Test unit written to //p" "$out/fuzz.log" | tail -1)
+if [ $rc -ne 0 ] || [ -n "$found" ]; then
   grep -E "^(==[0-9]+==ERROR|SUMMARY|.*runtime error|fuzz_scene:)" "$out/fuzz.log" | head -10 >&2 || true
-  found=$(sed -n "s/.*Test unit written to //p" "$out/fuzz.log" | tail -1)
   echo "run_fuzz.sh: found ${found:-a failure (exit $rc)}; replay it with $fuzz FILE," >&2
   echo "  fix it and add it to tests/fuzz/regressions/ (ctest -R fuzz_regressions replays them)" >&2
   exit 1

@@ -21,6 +21,8 @@ ns=(unshare --mount --propagation private)
 mkdir -p "$work/probe"
 if ! "${ns[@]}" mount -t tmpfs -o size=64k tmpfs "$work/probe" 2>"$work/err"; then
   echo "SKIP: cannot mount a tmpfs here (needs root or user namespaces): $(cat "$work/err")"
+  # CI (.ci/run, as root) sets SPH_FAULT_REQUIRE_TMPFS=1: there a skip fails
+  [ "${SPH_FAULT_REQUIRE_TMPFS:-0}" = 1 ] && exit 1
   exit 77
 fi
 
@@ -47,7 +49,8 @@ fill() {
   local kind=$1 where=$2 regex=$3 sweep=$4
   shift 5
   local args=("${small[@]}" "$@") ref=$work/$kind-ref
-  "$sph" run $scene --out "$ref" "${args[@]}" >/dev/null || { bad "$kind: uninterrupted run"; return; }
+  "$sph" run $scene --out "$ref" "${args[@]}" >"$work/$kind-ref.log" 2>&1 ||
+    { bad "$kind: uninterrupted run (exit $?): $(cat "$work/$kind-ref.log")"; return; }
   local used
   used=$(du -sk "$ref/$([ "$where" = frames ] && echo frames)" | cut -f1)
   local pct hit=""
