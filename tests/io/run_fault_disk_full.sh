@@ -4,7 +4,7 @@
 # output folder (for the frames: its frames/ folder) is a tmpfs too small
 # for the run; the run stops with exit 3 and an error naming the file that
 # did not fit, keeps every frame and CSV row written (kept_run:
-# compare_runs.sh), and once the space is back (the tmpfs grown) --resume
+# compare_runs.sh), and once the space is back (a filler file removed) --resume
 # finishes with the files of an uninterrupted run (same_run). The tmpfs is
 # mounted in a mount namespace of its own (unshare: as root, else in a user
 # namespace); where neither is allowed the test is skipped (exit 77). Each
@@ -20,23 +20,30 @@ ns=(unshare --mount --propagation private)
 [ "$(id -u)" -eq 0 ] || ns=(unshare --user --map-root-user --mount --propagation private)
 mkdir -p "$work/probe"
 if ! "${ns[@]}" mount -t tmpfs -o size=64k tmpfs "$work/probe" 2>"$work/err"; then
-  echo "SKIP: cannot mount a tmpfs here (needs root or user namespaces): $(cat "$work/err")"
+  why="cannot mount a tmpfs here (needs root or user namespaces): $(cat "$work/err")"
   # CI (.ci/run, as root) sets SPH_FAULT_REQUIRE_TMPFS=1: there a skip fails
-  [ "${SPH_FAULT_REQUIRE_TMPFS:-0}" = 1 ] && exit 1
+  [ "${SPH_FAULT_REQUIRE_TMPFS:-0}" = 1 ] && { echo "FAIL: $why"; exit 1; }
+  echo "SKIP: $why"
   exit 77
 fi
 
-# in the namespace: a tmpfs of SIZE kB at MOUNT, the run into OUT, a copy
-# of what it left in SNAP, the tmpfs grown to 64 MB, --resume, the result
-# copied to DONE (the tmpfs goes with the namespace)
-full_then_resume() { # mount size out snap done -- sph run args...
-  local mnt=$1 size=$2 out=$3 snap=$4 done=$5
-  shift 5
-  mkdir -p "$mnt" && mount -t tmpfs -o "size=${size}k" tmpfs "$mnt" || return 90
+# in the namespace: a tmpfs at BASE with SIZE kB free (4 MB more, taken by
+# a filler file: a user namespace may not grow a tmpfs), the run into OUT
+# (BASE/out, or any folder with BASE/frames bound as its frames/), a copy
+# of what it left in SNAP, the space back (the filler removed), --resume,
+# the result copied to DONE (the tmpfs goes with the namespace)
+full_then_resume() { # base size where out snap done -- sph run args...
+  local base=$1 size=$2 where=$3 out=$4 snap=$5 done=$6
+  shift 6
+  mkdir -p "$base" && mount -t tmpfs -o "size=$((size + 4096))k" tmpfs "$base" || return 90
+  if [ "$where" = frames ]; then
+    mkdir -p "$base/frames" "$out/frames" && mount --bind "$base/frames" "$out/frames" || return 91
+  fi
+  fallocate -l 4M "$base/filler" 2>/dev/null || head -c 4194304 /dev/zero >"$base/filler" || return 92
   "$@" --out "$out" >"$snap.log" 2>&1
   echo "exit $?" >>"$snap.log"
   cp -a "$out" "$snap"
-  mount -o remount,size=65536k "$mnt" || return 91
+  rm "$base/filler"
   "$@" --resume "$out" >"$done.log" 2>&1
   echo "exit $?" >>"$done.log"
   cp -a "$out" "$done"
@@ -56,12 +63,10 @@ fill() {
   local pct hit=""
   for pct in $sweep; do
     local size=$(((used * pct / 100 + 3) / 4 * 4)) t=$work/$kind-$pct
-    local out=$t/fs mnt=$t/fs
-    if [ "$where" = frames ]; then
-      mnt=$t/fs/frames
-    fi
+    local out=$t/fs/out
+    [ "$where" = frames ] && out=$t/out
     "${ns[@]}" bash -c "$(declare -f full_then_resume); full_then_resume \"\$@\"" _ \
-      "$mnt" "$size" "$out" "$t/snap" "$t/done" "$sph" run $scene "${args[@]}"
+      "$t/fs" "$size" "$where" "$out" "$t/snap" "$t/done" "$sph" run $scene "${args[@]}"
     local rc=$?
     [ $rc -eq 0 ] || { bad "$kind $size kB: no tmpfs (exit $rc)"; continue; }
     local msg
