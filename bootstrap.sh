@@ -2,6 +2,9 @@
 # Installs the Debian 12 packages sph needs to build, run and test, when they
 # are missing. Usable as root or through sudo. Options:
 #   --with-ffmpeg   also install ffmpeg (sph run then assembles an mp4)
+#   --with-fuzz     also install clang with libFuzzer and the sanitizer
+#                   runtimes, LLVM's OpenMP and symbolizer
+#                   (tests/fuzz/run_fuzz.sh)
 set -euo pipefail
 
 packages=(
@@ -21,6 +24,9 @@ packages=(
 for arg in "$@"; do
   case "$arg" in
     --with-ffmpeg) packages+=(ffmpeg) ;;
+    # clang-14's libFuzzer, ASan and UBSan runtimes are in libclang-rt-14-dev;
+    # clang builds OpenMP code against libomp; llvm-14 has llvm-symbolizer
+    --with-fuzz) packages+=(clang libclang-rt-14-dev libomp-14-dev llvm-14) ;;
     *) echo "bootstrap.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done

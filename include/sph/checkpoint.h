@@ -2,12 +2,15 @@
  * determines every later step of a run, so `sph run --resume DIR` continues
  * exactly where a killed run left off.
  *
- * Layout (little-endian, version 2; version 1 had no fracture and zig-zag
- * scalars in the verdict):
+ * Layout (little-endian, version 4; version 1 had no fracture and zig-zag
+ * scalars in the verdict, 3 and before no call counts):
  *   "SPHCKPT\0"  u32 version  u32 endianness tag 0x01020304
  *   u64 particles  char method[32]  char scene[64]  u32 scene_crc
  *   f64 t  u64 steps  f64 dt_min dt_max dt_last  i32 next_output
- *   the verdict (its scalars)  u32 narrays
+ *   the verdict (its scalars)
+ *   u32 ncalls, ncalls x u64: how often each timer's part, then each term,
+ *     ran (summary.json "calls" of a resumed run equal an uninterrupted's)
+ *   u32 narrays
  *   narrays x (char name[16], u64 length): the method's state arrays,
  *     then the scene reference's measurement ("reference") if it keeps one
  *   the arrays' f64 data
@@ -21,8 +24,9 @@
 #include "sph/stability.h"
 #include "sph/status.h"
 
-/* 3: particles in Morton storage order (sph_particles_sort_morton) */
-#define SPH_CHECKPOINT_VERSION 3u
+/* 3: particles in Morton storage order (sph_particles_sort_morton);
+ * 4: call counts */
+#define SPH_CHECKPOINT_VERSION 4u
 #define SPH_CHECKPOINT_FILE "checkpoint.sphc"
 #define SPH_CHECKPOINT_PREVIOUS "checkpoint.prev.sphc"
 

@@ -59,9 +59,15 @@ sph_status sph_node_error(const sph_node *n, sph_error *err, sph_status code,
                           const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
+/* SPH_ERR_MISSING_KEY at map for its required key `key`. */
+sph_status sph_node_missing(const sph_node *map, const char *key,
+                            sph_error *err);
+
 /* Typed reads of a map's key. `required` != 0 makes a missing key an error
- * at the map; otherwise the default is inserted into the tree and returned.
- * Wrong types are errors at the value. */
+ * at the map; otherwise the default is inserted into the tree and returned
+ * (a non-finite double default, "none", is returned but not inserted: no
+ * scene can hold it, and the resolved tree must load again). Wrong types
+ * are errors at the value. */
 sph_status sph_node_get_double(sph_node *map, const char *key, int required,
                                double def, double *out, sph_error *err);
 sph_status sph_node_get_int(sph_node *map, const char *key, int required,

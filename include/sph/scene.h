@@ -214,6 +214,9 @@ typedef struct sph_scene {
   double t_end;
   sph_output output;
   sph_stability_options stability;
+  /* bytes a run may take (0: 90 % of the memory available); set by the
+   * caller after loading (sph run/check --max-memory), not a scene key */
+  double memory_limit;
 } sph_scene;
 
 /* Loads and validates `path`, after applying `nset` overrides "a.b=value". */

@@ -63,14 +63,15 @@ typedef struct sph_atomic_file {
 sph_status sph_atomic_open(sph_atomic_file *af, const char *path,
                            sph_error *err);
 sph_status sph_atomic_commit(sph_atomic_file *af, sph_error *err);
-/* As sph_atomic_open, starting the new file with the first `lines` lines
- * of the earlier <path> (or of its temporary file, if the run that wrote
- * it was killed); fails if it has fewer. */
 /* A stream under its final name (tmp empty: commit closes it in place,
  * abort keeps it): fresh (lines 0) or keeping the first `lines` complete
- * lines of the file (a resume). */
+ * lines of the file (a resume: the file is cut after them in place, so a
+ * resume killed at once loses nothing; fails if it has fewer). */
 sph_status sph_stream_open(sph_atomic_file *af, const char *path, size_t lines,
                            sph_error *err);
+/* Ends a stream's row: flushed, so it can be read now; the error names the
+ * file and the reason (disk full, file too large). */
+sph_status sph_stream_row_end(sph_atomic_file *af, sph_error *err);
 /* Flushes and fsyncs the temporary file. */
 sph_status sph_atomic_flush(sph_atomic_file *af, sph_error *err);
 /* Closes and removes the temporary file (safe after a failed commit). */

@@ -6,6 +6,7 @@
 #ifndef SPH_STATUS_H
 #define SPH_STATUS_H
 
+#include <stdarg.h>
 #include <stddef.h>
 
 #define SPH_STATUS_LIST(X)                                                     \
@@ -52,10 +53,23 @@ void sph_error_clear(sph_error *err);
 sph_status sph_error_set(sph_error *err, sph_status code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-/* As sph_error_set, with an input location and key. */
+/* As sph_error_set, with an input location and key (a key path too long
+ * for the record shortened by sph_key_path_fit). A message too long for
+ * the record is cut at a word or key boundary and ends with an ellipsis. */
 sph_status sph_error_at(sph_error *err, sph_status code, const char *file,
                         int line, int col, const char *key, const char *fmt,
                         ...) __attribute__((format(printf, 7, 8)));
+
+/* Copies the key path `path` ("bodies[0].shape.box.min") into dst; one
+ * too long is shortened at token boundaries (a key or an [index]), the
+ * tokens left out shown as one ellipsis: "bodies.…[3].at". Never cuts a
+ * token. NULL copies "". */
+void sph_key_path_fit(char *dst, size_t size, const char *path);
+
+/* sph_error_at with a va_list. */
+sph_status sph_error_atv(sph_error *err, sph_status code, const char *file,
+                         int line, int col, const char *key, const char *fmt,
+                         va_list ap);
 
 /* Returns from the calling function when `expr` is not SPH_OK. */
 #define SPH_TRY(expr)                                                          \

@@ -30,6 +30,8 @@ typedef struct sph_app_args {
   int overwrite;      /* --overwrite */
   int quiet;          /* --quiet */
   int keys;           /* check --keys */
+  int resolved;       /* check --resolved */
+  double max_memory;  /* --max-memory BYTES (0: the memory available) */
 } sph_app_args;
 
 /* The options of every command (ids of options.c's shared table). */
@@ -58,7 +60,9 @@ enum {
   SPH_OPT_WIDTH,
   SPH_OPT_HEIGHT,
   SPH_OPT_MP4,
-  SPH_OPT_KEYS
+  SPH_OPT_KEYS,
+  SPH_OPT_MAX_MEMORY,
+  SPH_OPT_RESOLVED
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows
@@ -83,14 +87,34 @@ int sph_app_getopt(const sph_app_command *cmd, int argc, char **argv,
 int sph_app_count(const char *command, const char *opt, const char *val,
                   int max, int *out);
 
+/* --max-memory's value: bytes, or a number with the suffix k, M, G or T
+ * (powers of 1000; "4G", "512M", "1.5e9"); 0 or 2 with a message. */
+int sph_app_bytes(const char *val, double *out);
+
+struct sph_scene;
+struct sph_sim;
+/* What sph check validates, without printing: the scene at `path` with the
+ * overrides, its memory estimate against max_memory (0: the memory
+ * available), the particles, the method and its terms, the png block. On
+ * success *scene and *sim are the caller's; on failure both are NULL and
+ * err says why. */
+sph_status sph_app_check_scene(const char *path, const char *const *sets,
+                               size_t nsets, double max_memory,
+                               struct sph_scene **scene, struct sph_sim **sim,
+                               sph_error *err);
+
 /* Parses run's and check's argv into args; returns 0, 2 or SPH_APP_HELP. */
 int sph_app_parse_args(int argc, char **argv, sph_app_args *args,
                        const sph_app_command *cmd);
 
-/* The shipped scenes folder and the default scene. */
 /* mkdir -p: 0, or -1 with errno set */
 int sph_app_mkdir_p(const char *path);
+/* An output folder made when missing (parents too) and tried by writing a
+ * file in it: SPH_OK, or SPH_ERR_ARG (exit 2) naming the folder, the same
+ * whether it cannot be made or exists and cannot be written in. */
+sph_status sph_app_output_dir(const char *dir, sph_error *err);
 
+/* The shipped scenes folder and the default scene. */
 const char *sph_app_scenes_dir(void);
 const char *sph_app_default_scene(void);
 /* The shipped scene files (NAME.yaml), sorted, each strdup'd; their count. */
@@ -107,8 +131,6 @@ void sph_app_provenance(struct sph_provenance *prov);
 /* Prints "sph: file:line:col: key: message" to stderr. */
 void sph_app_print_error(const sph_error *err);
 
-struct sph_scene;
-struct sph_sim;
 /* Loads the scene with its overrides and creates the simulation; prints the
  * error and returns SPH_EXIT_USAGE on bad input. */
 int sph_app_load(const sph_app_args *args, const char *path,

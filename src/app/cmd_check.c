@@ -49,14 +49,19 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
          peak_rss_mib(), (double)sph_particles_bytes(ps) / 1048576.0);
 }
 
-static const int check_allowed[] = {SPH_OPT_SET, SPH_OPT_KEYS, 0};
+static const int check_allowed[] = {SPH_OPT_SET, SPH_OPT_KEYS, SPH_OPT_RESOLVED,
+                                    SPH_OPT_MAX_MEMORY, 0};
 static const sph_app_command check_command = {
     "check",
-    "usage: sph check SCENE [--set key=value]... [--keys]\n"
+    "usage: sph check SCENE [--set key=value]... [--keys | --resolved]\n"
+    "                 [--max-memory SIZE]\n"
     "  validate SCENE (a file or a shipped scene's name) and print what a\n"
     "  run would simulate: bodies, method, terms, time step, memory;\n"
     "  --keys: every key the scene has, defaults filled in, as --set writes\n"
-    "  it (bodies.0.particles.count), one per line\n",
+    "  it (bodies.0.particles.count), one per line; --resolved: the scene\n"
+    "  with every default filled in, as a run's scene_used.yaml holds it;\n"
+    "  --max-memory: refuse a scene estimated to need more than SIZE (4G,\n"
+    "  512M; default 90 % of the memory available)\n",
     check_allowed, NULL, NULL};
 
 /* --keys: the resolved tree's key paths in --set's form ([k] -> .k) */
@@ -87,11 +92,16 @@ int sph_cmd_check(int argc, char **argv) {
   sph_sim *sim;
   if ((rc = sph_app_load(&args, args.scene, &scene, &sim)) != SPH_EXIT_OK)
     return rc;
+  sph_error err;
   if (args.keys)
     print_keys(scene->root);
-  else
+  else if (args.resolved &&
+           sph_node_write(scene->root, stdout, &err) != SPH_OK) {
+    sph_app_print_error(&err); /* stdout closed or full */
+    rc = SPH_EXIT_IO;
+  } else if (!args.resolved)
     print_plan(scene, sim);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
-  return SPH_EXIT_OK;
+  return rc;
 }

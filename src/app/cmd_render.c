@@ -275,9 +275,7 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
       snprintf(j.out, sizeof j.out, "%s", a->out);
     else
       snprintf(j.out, sizeof j.out, "%s/render", j.dir);
-    if (sph_app_mkdir_p(j.out) != 0)
-      st = sph_error_at(err, SPH_ERR_IO, j.out, 0, 0, NULL,
-                        "cannot create the folder: %s", strerror(errno));
+    st = sph_app_output_dir(j.out, err);
   }
   if (st == SPH_OK)
     st = render_frames(&j, frames, err);
@@ -329,9 +327,7 @@ int sph_cmd_render(int argc, char **argv) {
   if (st == SPH_OK)
     return SPH_EXIT_OK;
   sph_app_print_error(&err);
-  /* a missing or damaged .vtp or .pvd is bad input */
-  return st == SPH_ERR_NOMEM ? SPH_EXIT_IO
-         : st == SPH_ERR_IO && strstr(err.message, "cannot create")
-             ? SPH_EXIT_IO
-             : SPH_EXIT_USAGE;
+  /* a missing or damaged .vtp or .pvd is bad input, as is an output
+   * folder that cannot be made or written in */
+  return st == SPH_ERR_NOMEM ? SPH_EXIT_IO : SPH_EXIT_USAGE;
 }

@@ -187,20 +187,18 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
   return st;
 }
 
-static const int run_allowed[] = {SPH_OPT_SET,
-                                  SPH_OPT_OUT,
-                                  SPH_OPT_THREADS,
-                                  SPH_OPT_RESUME_DIR,
-                                  SPH_OPT_OVERWRITE,
-                                  SPH_OPT_QUIET,
-                                  0};
+static const int run_allowed[] = {
+    SPH_OPT_SET,       SPH_OPT_OUT,   SPH_OPT_THREADS,    SPH_OPT_RESUME_DIR,
+    SPH_OPT_OVERWRITE, SPH_OPT_QUIET, SPH_OPT_MAX_MEMORY, 0};
 static const sph_app_command run_command = {
     "run",
     "usage: sph run [SCENE] [--set key=value]... [--out DIR] [--threads N]\n"
-    "               [--overwrite] [--quiet] [--resume DIR]\n"
+    "               [--overwrite] [--quiet] [--resume DIR] [--max-memory "
+    "SIZE]\n"
     "  simulate SCENE (a file, or a shipped scene's name: sph list; default\n"
     "  twisting_column) to its end time; exit 0 stable, 1 unstable, 2 bad\n"
-    "  input or usage, 3 I/O failure\n",
+    "  input or usage, 3 I/O failure; a run estimated to need more than\n"
+    "  SIZE (4G, 512M; default 90 % of the memory available) is refused\n",
     run_allowed, NULL, NULL};
 
 /* SIGINT, SIGTERM, SIGHUP: the first asks the run to stop at the next step
@@ -300,40 +298,41 @@ int sph_cmd_run(int argc, char **argv) {
     snprintf(dir, sizeof dir, "%s", args.out);
   else
     snprintf(dir, sizeof dir, "outputs/%s", scene->name);
-  if ((file_exists(dir, "summary.json") ||
-       file_exists(dir, "scene_used.yaml")) &&
-      !args.overwrite && !args.resume) {
-    fprintf(stderr,
-            "sph: %s holds the results of an earlier run; pass --overwrite "
-            "to replace them or --out DIR to write elsewhere\n",
-            dir);
+  /* a folder that cannot be made or written in: exit 2 either way */
+  long holder = 0;
+  int lock_fd = -1;
+  struct stat rst;
+  if (args.resume && stat(dir, &rst) != 0) /* not made for a resume */
+    st = sph_error_set(&err, SPH_ERR_ARG, "nothing to resume in %s: %s", dir,
+                       strerror(errno));
+  else
+    st = sph_app_output_dir(dir, &err);
+  if (st == SPH_OK && (lock_fd = lock_output(dir, &holder)) < 0) {
+    if (holder > 0)
+      st = sph_error_set(&err, SPH_ERR_ARG,
+                         "%s is in use by another sph run (pid %ld); wait for "
+                         "it or write elsewhere with --out DIR",
+                         dir, holder);
+    else
+      st = sph_error_set(&err, SPH_ERR_ARG,
+                         "cannot write in the output folder %s: %s", dir,
+                         strerror(errno));
+  }
+  /* after the lock: a folder in use says so, whatever it holds */
+  if (st == SPH_OK && !args.overwrite && !args.resume &&
+      (file_exists(dir, "summary.json") || file_exists(dir, "scene_used.yaml")))
+    st = sph_error_set(&err, SPH_ERR_ARG,
+                       "%s holds the results of an earlier run; pass "
+                       "--overwrite to replace them or --out DIR to write "
+                       "elsewhere",
+                       dir);
+  if (st != SPH_OK) {
+    sph_app_print_error(&err);
+    if (lock_fd >= 0)
+      close(lock_fd);
     sph_sim_destroy(sim);
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
-  }
-  struct stat dst;
-  int made = sph_app_mkdir_p(dir) == 0 && stat(dir, &dst) == 0;
-  if (!made || !S_ISDIR(dst.st_mode)) {
-    fprintf(stderr, "sph: cannot create the output folder %s: %s\n", dir,
-            made ? "a file of that name exists" : strerror(errno));
-    sph_sim_destroy(sim);
-    sph_scene_destroy(scene);
-    return SPH_EXIT_IO;
-  }
-  long holder;
-  int lock_fd = lock_output(dir, &holder);
-  if (lock_fd < 0) {
-    if (holder > 0)
-      fprintf(stderr,
-              "sph: %s is in use by another sph run (pid %ld); wait for it "
-              "or write elsewhere with --out DIR\n",
-              dir, holder);
-    else
-      fprintf(stderr, "sph: cannot lock the output folder %s: %s\n", dir,
-              strerror(errno));
-    sph_sim_destroy(sim);
-    sph_scene_destroy(scene);
-    return holder > 0 ? SPH_EXIT_USAGE : SPH_EXIT_IO;
   }
   if (args.overwrite && !args.resume)
     remove_previous(dir, scene->name);

@@ -457,6 +457,11 @@ static int run_study(study *s, study_args *a) {
       return SPH_EXIT_USAGE;
     }
   }
+  sph_error derr;
+  if (sph_app_output_dir(s->dir, &derr) != SPH_OK) {
+    sph_app_print_error(&derr);
+    return SPH_EXIT_USAGE;
+  }
   char runs[1100];
   snprintf(runs, sizeof runs, "%s/runs", s->dir);
   if (sph_app_mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {

@@ -172,6 +172,30 @@ int sph_app_mkdir_p(const char *path) {
   return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
 }
 
+sph_status sph_app_output_dir(const char *dir, sph_error *err) {
+  struct stat st;
+  if (sph_app_mkdir_p(dir) != 0 || stat(dir, &st) != 0)
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "cannot create the output folder %s: %s", dir,
+                         strerror(errno));
+  if (!S_ISDIR(st.st_mode))
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "cannot create the output folder %s: a file of that "
+                         "name exists",
+                         dir);
+  /* permissions do not stop root: a file made and removed again tells */
+  char probe[1100];
+  snprintf(probe, sizeof probe, "%s/.sph-probe-XXXXXX", dir);
+  int fd = mkstemp(probe);
+  if (fd < 0)
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "cannot write in the output folder %s: %s", dir,
+                         strerror(errno));
+  close(fd);
+  unlink(probe);
+  return SPH_OK;
+}
+
 static int args_option(void *ctx, int id, const char *val) {
   sph_app_args *args = ctx;
   switch (id) {
@@ -199,6 +223,11 @@ static int args_option(void *ctx, int id, const char *val) {
   case SPH_OPT_KEYS:
     args->keys = 1;
     return SPH_EXIT_OK;
+  case SPH_OPT_RESOLVED:
+    args->resolved = 1;
+    return SPH_EXIT_OK;
+  case SPH_OPT_MAX_MEMORY:
+    return sph_app_bytes(val, &args->max_memory);
   default:
     return SPH_EXIT_USAGE;
   }
@@ -235,20 +264,10 @@ int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
                  sph_sim **sim) {
   sph_error err;
   sph_error_clear(&err);
-  *scene = NULL;
-  *sim = NULL;
-  sph_status st = sph_scene_load(scene, path, args->sets, args->nsets, &err);
-  if (st == SPH_OK)
-    st = sph_sim_create(sim, *scene, &err);
-  if (st == SPH_OK)
-    st = sph_png_check(*sim, &err);
-  if (st == SPH_OK)
+  if (sph_app_check_scene(path, args->sets, args->nsets, args->max_memory,
+                          scene, sim, &err) == SPH_OK)
     return SPH_EXIT_OK;
-  sph_sim_destroy(*sim);
-  *sim = NULL;
   sph_app_print_error(&err);
-  sph_scene_destroy(*scene);
-  *scene = NULL;
   return SPH_EXIT_USAGE;
 }
 

@@ -35,6 +35,8 @@ static const struct option all_options[] = {
     {"height", required_argument, NULL, SPH_OPT_HEIGHT},
     {"mp4", no_argument, NULL, SPH_OPT_MP4},
     {"keys", no_argument, NULL, SPH_OPT_KEYS},
+    {"max-memory", required_argument, NULL, SPH_OPT_MAX_MEMORY},
+    {"resolved", no_argument, NULL, SPH_OPT_RESOLVED},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 
@@ -89,5 +91,29 @@ int sph_app_count(const char *command, const char *opt, const char *val,
     return SPH_EXIT_USAGE;
   }
   *out = (int)n;
+  return SPH_EXIT_OK;
+}
+
+int sph_app_bytes(const char *val, double *out) {
+  char *end;
+  double x = strtod(val, &end);
+  static const char suffixes[] = "kMGT";
+  const char *s = *end ? strchr(suffixes, *end) : NULL;
+  if (s && *end) {
+    x *= s == suffixes       ? 1e3
+         : s == suffixes + 1 ? 1e6
+         : s == suffixes + 2 ? 1e9
+                             : 1e12;
+    ++end;
+    end += *end == 'B';
+  }
+  if (end == val || *end || !(x >= 1e6 && x <= 1e18)) {
+    fprintf(stderr,
+            "sph: --max-memory takes a size from 1M to 1000000T, e.g. 4G, "
+            "512M or bytes (got '%s')\n",
+            val);
+    return SPH_EXIT_USAGE;
+  }
+  *out = x;
   return SPH_EXIT_OK;
 }

@@ -42,6 +42,76 @@ static void copy_str(char *dst, size_t size, const char *src) {
   snprintf(dst, size, "%s", src);
 }
 
+#define ELLIPSIS "\xe2\x80\xa6" /* U+2026, 3 bytes in UTF-8 */
+
+/* Start of the token after the one starting at p (a token is a map key or
+ * a [index]; "." and "[" begin the next), or the terminating NUL. */
+static const char *next_token(const char *p) {
+  if (!*p)
+    return p;
+  if (*p == '[') {
+    const char *close = strchr(p, ']');
+    p = close ? close + 1 : p + strlen(p);
+  } else {
+    p += *p == '.';
+    p += strcspn(p, ".[");
+  }
+  return p;
+}
+
+void sph_key_path_fit(char *dst, size_t size, const char *path) {
+  if (size == 0)
+    return;
+  size_t len = path ? strlen(path) : 0;
+  if (len < size) {
+    copy_str(dst, size, path);
+    return;
+  }
+  /* whole tokens only: the first token, an ellipsis for the tokens left
+   * out, then as many of the last tokens as fit, then as many more of the
+   * first ones ("bodies.…[2].at", "bodies[0].shape.box.…"); a first token
+   * too long is left out too */
+  size_t room = size - 1, ell = sizeof ELLIPSIS - 1;
+  const char *end = path + len;
+  size_t head = (size_t)(next_token(path) - path);
+  if (head + 1 + ell > room)
+    head = 0;
+#define FITS(h, t) ((h) + ((h) ? 1 : 0) + ell + (size_t)(end - (t)) <= room)
+  const char *tail = end;
+  for (const char *t = path + head; *t; t = next_token(t))
+    if (FITS(head, t)) {
+      tail = t;
+      break;
+    }
+  if (!FITS(head, tail)) {
+    dst[0] = '\0'; /* not even an ellipsis fits */
+    return;
+  }
+  for (const char *t = next_token(path + head); head && t < tail;
+       t = next_token(t)) {
+    if (!FITS((size_t)(t - path), tail))
+      break;
+    head = (size_t)(t - path);
+  }
+#undef FITS
+  snprintf(dst, size, "%.*s%s%s%s", (int)head, path, head ? "." : "", ELLIPSIS,
+           tail);
+}
+
+/* vsnprintf, a message too long cut at a word or key boundary (space,
+ * '.', '[', quote, comma, colon) and ended with an ellipsis, never in the
+ * middle of a key or word */
+static void fit_message(char *dst, size_t size, const char *fmt, va_list ap) {
+  int n = vsnprintf(dst, size, fmt, ap);
+  size_t ell = sizeof ELLIPSIS - 1;
+  if (n < 0 || (size_t)n < size || size <= ell + 1)
+    return;
+  size_t cut = size - 1 - ell;
+  while (cut > 0 && !strchr(" .[',:", dst[cut]))
+    --cut;
+  memcpy(dst + cut, ELLIPSIS, ell + 1);
+}
+
 sph_status sph_error_set(sph_error *err, sph_status code, const char *fmt,
                          ...) {
   if (!err)
@@ -50,25 +120,32 @@ sph_status sph_error_set(sph_error *err, sph_status code, const char *fmt,
   err->code = code;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(err->message, sizeof err->message, fmt, ap);
+  fit_message(err->message, sizeof err->message, fmt, ap);
   va_end(ap);
+  return code;
+}
+
+sph_status sph_error_atv(sph_error *err, sph_status code, const char *file,
+                         int line, int col, const char *key, const char *fmt,
+                         va_list ap) {
+  if (!err)
+    return code;
+  sph_error_clear(err);
+  err->code = code;
+  copy_str(err->file, sizeof err->file, file);
+  sph_key_path_fit(err->key, sizeof err->key, key);
+  err->line = line;
+  err->col = col;
+  fit_message(err->message, sizeof err->message, fmt, ap);
   return code;
 }
 
 sph_status sph_error_at(sph_error *err, sph_status code, const char *file,
                         int line, int col, const char *key, const char *fmt,
                         ...) {
-  if (!err)
-    return code;
-  sph_error_clear(err);
-  err->code = code;
-  copy_str(err->file, sizeof err->file, file);
-  copy_str(err->key, sizeof err->key, key);
-  err->line = line;
-  err->col = col;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(err->message, sizeof err->message, fmt, ap);
+  sph_error_atv(err, code, file, line, col, key, fmt, ap);
   va_end(ap);
   return code;
 }

@@ -62,8 +62,10 @@ sph_status sph_stream_open(sph_atomic_file *af, const char *path, size_t lines,
   snprintf(tmp, sizeof tmp, "%s.part", path);
   char *buf = NULL;
   size_t len = 0;
-  if (lines > 0) { /* resume: the lines the checkpoint counts */
+  int in_place = 0; /* the lines kept are the start of <path> */
+  if (lines > 0) {  /* resume: the lines the checkpoint counts */
     FILE *f = fopen(path, "r");
+    in_place = f != NULL;
     if (!f)
       f = fopen(tmp, "r"); /* written by an earlier version */
     if (!f)
@@ -93,16 +95,30 @@ sph_status sph_stream_open(sph_atomic_file *af, const char *path, size_t lines,
                           have, lines);
     }
   }
-  af->f = fopen(path, "w");
+  /* a resume cuts the file after the lines it keeps, in place: killed at
+   * any moment, the file still holds them (rewriting it would lose every
+   * row until the first flush) */
+  if (in_place)
+    af->f = truncate(path, (off_t)len) == 0 ? fopen(path, "a") : NULL;
+  else
+    af->f = fopen(path, "w");
   if (!af->f) {
     free(buf);
     return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
                         "cannot create the file: %s", strerror(errno));
   }
   remove(tmp);
-  if (len)
+  if (len && !in_place)
     fwrite(buf, 1, len, af->f);
   free(buf);
+  return SPH_OK;
+}
+
+sph_status sph_stream_row_end(sph_atomic_file *af, sph_error *err) {
+  if (fflush(af->f) != 0 || ferror(af->f)) /* the row is readable now */
+    return sph_error_at(err, SPH_ERR_IO, af->path, 0, 0, NULL,
+                        "cannot write the file: %s",
+                        strerror(errno ? errno : EIO));
   return SPH_OK;
 }
 

@@ -129,6 +129,22 @@ static void put_header(writer *w, const header *h) {
     put(w, (const char *)h + header_fields[i].off, header_fields[i].size);
 }
 
+/* How often each timer's part and each term ran (summary.json "calls"), so
+ * a resumed run reports the counts of an uninterrupted one: u32 count, then
+ * that many u64, the timers' then the terms'. */
+static void put_calls(writer *w, const sph_sim *sim) {
+  uint32_t n = (uint32_t)(sim->ntimers + sim->nterms);
+  put(w, &n, 4);
+  for (int i = 0; i < sim->ntimers; ++i) {
+    uint64_t c = sim->timers[i].calls;
+    put(w, &c, 8);
+  }
+  for (int i = 0; i < sim->nterms; ++i) {
+    uint64_t c = sim->terms[i].calls;
+    put(w, &c, 8);
+  }
+}
+
 sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
                                 const sph_verdict *v, int next_output,
                                 sph_error *err) {
@@ -148,6 +164,7 @@ sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
   put_header(&w, &h);
   for (size_t i = 0; i < NVERDICT; ++i)
     put(&w, (const char *)v + verdict_fields[i].off, verdict_fields[i].size);
+  put_calls(&w, sim);
   uint32_t n32 = (uint32_t)na;
   put(&w, &n32, 4);
   for (int i = 0; i < na; ++i) {
@@ -268,6 +285,15 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
     if (!get(&r, (char *)&vv + verdict_fields[i].off, verdict_fields[i].size))
       FAIL("truncated verdict");
   vv.reason[sizeof vv.reason - 1] = '\0';
+  uint32_t ncalls = 0;
+  uint64_t calls[SPH_MAX_TIMERS + SPH_MAX_TERMS];
+  if (!get(&r, &ncalls, 4))
+    FAIL("truncated call counts");
+  if (ncalls != (uint32_t)(sim->ntimers + sim->nterms))
+    FAIL("holds %u call counts, the run has %d timers and terms", ncalls,
+         sim->ntimers + sim->nterms);
+  if (!get(&r, calls, ncalls * sizeof *calls))
+    FAIL("truncated call counts");
   sph_state_array arr[SPH_MAX_STATE + 1];
   int nm = sim->method->state(sim, arr);
   nm += sph_reference_state(sim->reference, arr + nm);
@@ -293,6 +319,11 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
     get(&r, arr[i].data, arr[i].len * sizeof(double));
   if (sim->method->restore && (st = sim->method->restore(sim, err)) != SPH_OK)
     goto done;
+  /* after restore, which may count a rebuild of its own */
+  for (int i = 0; i < sim->ntimers; ++i)
+    sim->timers[i].calls = (unsigned long)calls[i];
+  for (int i = 0; i < sim->nterms; ++i)
+    sim->terms[i].calls = (unsigned long)calls[sim->ntimers + i];
   sim->t = h.t;
   sim->steps = (unsigned long)h.steps;
   sim->dt_min = h.dt_min;

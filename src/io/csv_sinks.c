@@ -72,10 +72,7 @@ static sph_status energy_write(sph_sink *sink, const sph_frame *fr,
           "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
           fr->time, fr->kinetic, fr->strain, fr->kinetic + fr->strain, lin[0],
           lin[1], lin[2], ang[0], ang[1], ang[2]);
-  fflush(af->f); /* the row is readable now */
-  return ferror(af->f) ? sph_error_at(err, SPH_ERR_IO, af->path, 0, 0, NULL,
-                                      "cannot write")
-                       : SPH_OK;
+  return sph_stream_row_end(af, err);
 }
 
 const sph_sink_ops sph_energy_sink_ops = {
@@ -161,10 +158,7 @@ static sph_status probe_write(sph_sink *sink, const sph_frame *fr,
     }
   }
   fputc('\n', p->af.f);
-  fflush(p->af.f); /* the row is readable now */
-  return ferror(p->af.f) ? sph_error_at(err, SPH_ERR_IO, p->af.path, 0, 0, NULL,
-                                        "cannot write")
-                         : SPH_OK;
+  return sph_stream_row_end(&p->af, err);
 }
 
 static void probe_destroy(sph_sink *sink) {

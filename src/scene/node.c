@@ -447,14 +447,14 @@ sph_node *sph_node_child(const sph_node *map, const char *key) {
 
 sph_status sph_node_error(const sph_node *n, sph_error *err, sph_status code,
                           const char *fmt, ...) {
-  char msg[768];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(msg, sizeof msg, fmt, ap);
+  if (n)
+    sph_error_atv(err, code, n->file, n->line, n->col, n->path, fmt, ap);
+  else
+    sph_error_atv(err, code, NULL, 0, 0, NULL, fmt, ap);
   va_end(ap);
-  if (!n)
-    return sph_error_set(err, code, "%s", msg);
-  return sph_error_at(err, code, n->file, n->line, n->col, n->path, "%s", msg);
+  return code;
 }
 
 size_t sph_edit_distance(const char *a, const char *b) {
@@ -598,8 +598,8 @@ sph_status sph_node_as_bool(const sph_node *n, int *out, sph_error *err) {
 
 /* ---- getters ---- */
 
-static sph_status missing(const sph_node *map, const char *key,
-                          sph_error *err) {
+sph_status sph_node_missing(const sph_node *map, const char *key,
+                            sph_error *err) {
   char *path = join_key(map->path, key);
   sph_status st =
       sph_error_at(err, SPH_ERR_MISSING_KEY, map->file, map->line, map->col,
@@ -653,7 +653,7 @@ static sph_status lookup(sph_node *map, const char *key, int required,
                           kind_name(map->kind));
   *child = sph_node_child(map, key);
   if (!*child)
-    return required ? missing(map, key, err) : SPH_OK;
+    return required ? sph_node_missing(map, key, err) : SPH_OK;
   (*child)->used = 1;
   return SPH_OK;
 }
@@ -664,11 +664,12 @@ sph_status sph_node_get_double(sph_node *map, const char *key, int required,
   SPH_TRY(lookup(map, key, required, &c, err));
   if (c)
     return sph_node_as_double(c, out, err);
+  *out = def;
+  if (!isfinite(def)) /* "none" (NAN): a scene cannot give it, so the */
+    return SPH_OK;    /* resolved tree leaves the key out to load back */
   char buf[40];
   format_double(def, buf, sizeof buf);
-  SPH_TRY(insert_scalar(map, key, buf, &c, err));
-  *out = def;
-  return SPH_OK;
+  return insert_scalar(map, key, buf, &c, err);
 }
 
 sph_status sph_node_get_int(sph_node *map, const char *key, int required,
@@ -844,13 +845,14 @@ sph_status sph_node_set(sph_node *root, const char *assignment,
 
   /* walk to the parent, creating maps */
   sph_node *cur = root;
-  char here[600];
+  /* key (< 512) with each index part "i." as "[i]": under 768 */
+  char here[1024];
   snprintf(here, sizeof here, "%s", root->path);
   for (char *part = key; part && st == SPH_OK;) {
     char *next = strchr(part, '.');
     if (next)
       *next++ = '\0';
-    char walked[600];
+    char walked[1024];
     snprintf(walked, sizeof walked, "%s", *here ? here : "(root)");
     sph_node **slot = NULL;
     if (cur->kind == SPH_NODE_SCALAR) {

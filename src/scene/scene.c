@@ -27,13 +27,7 @@ static sph_status get_seq(sph_node *map, const char *key, int required,
                           sph_node **out, sph_error *err) {
   *out = sph_node_child(map, key);
   if (!*out) {
-    if (!required)
-      return SPH_OK;
-    char path[256];
-    snprintf(path, sizeof path, "%s%s%s", map->path, *map->path ? "." : "",
-             key);
-    return sph_error_at(err, SPH_ERR_MISSING_KEY, map->file, map->line,
-                        map->col, path, "missing required key '%s'", key);
+    return required ? sph_node_missing(map, key, err) : SPH_OK;
   }
   (*out)->used = 1;
   if ((*out)->kind != SPH_NODE_SEQ)

@@ -69,9 +69,10 @@ static sph_status check_output_fields(const sph_sim *sim, sph_error *err) {
 }
 
 /* Refuses, before anything is allocated, a run that would not fit in the
- * memory available: particles bounded from the bodies' lattices, each with
- * about 1 kB of fields and 24 bytes per neighbour slot (tl-jst measured 2.6
- * to 2.7 kB per particle in 3D, sph bench). */
+ * memory available (or the scene's memory_limit, when lower): particles bounded
+ * from the bodies' lattices, each with about 1 kB of fields and 24 bytes per
+ * neighbour slot (tl-jst measured 2.6 to 2.7 kB per particle in 3D, sph bench).
+ */
 static sph_status check_memory(const sph_scene *scene, double support,
                                double dp, sph_error *err) {
   int dim = scene->dimension;
@@ -98,9 +99,17 @@ static sph_status check_memory(const sph_scene *scene, double support,
     }
   if (f)
     fclose(f);
-  if (!(avail > 0.0) || need <= 0.9 * avail)
+  double limit = scene->memory_limit;
+  int by_limit = limit > 0.0 && !(avail > 0.0 && 0.9 * avail < limit);
+  if (by_limit ? need <= limit : !(avail > 0.0) || need <= 0.9 * avail)
     return SPH_OK;
   const sph_node *bodies = sph_node_child(scene->root, "bodies");
+  if (by_limit)
+    return sph_node_error(bodies ? bodies : scene->root, err, SPH_ERR_RANGE,
+                          "about %.3g particles need about %.3g GB; the limit "
+                          "(--max-memory) is %.3g GB: fewer particles (a "
+                          "larger spacing or count)",
+                          n, need / 1e9, limit / 1e9);
   return sph_node_error(
       bodies ? bodies : scene->root, err, SPH_ERR_RANGE,
       "about %.3g particles need about %.1f GB; %.1f GB of memory is "

@@ -81,9 +81,35 @@ rc=$?
 rc=$?
 [ $rc -eq 2 ] && [ ! -e "$work/e2" ] && ok || bad "bad input: exit $rc"
 touch "$work/plain"
-"$sph" run "$tiny" --out "$work/plain" "${quick[@]}" >/dev/null 2>"$work/stderr"
-rc=$?
-[ $rc -eq 3 ] && grep -qF "$work/plain" "$work/stderr" && ok || bad "--out a file: exit $rc: $(cat "$work/stderr")"
+# an output folder that cannot be made or written in is bad input, exit 2
+# naming it, whether it exists or not (issue 21 item 13; it was 1 or 2,
+# then 3); permissions do not stop root (CI), so a file in the path and
+# /proc (nothing can be made in it) stand in for them, and a folder
+# without write permission is tried when not root
+unwritable() { # message, folder, command...
+  local msg=$1 dir=$2
+  shift 2
+  "$@" >/dev/null 2>"$work/stderr"
+  local rc=$?
+  [ $rc -eq 2 ] && grep -qF "sph: $msg $dir: " "$work/stderr" && ok ||
+    bad "unwritable $dir ($*): exit $rc: $(cat "$work/stderr")"
+}
+made="cannot create the output folder"
+written="cannot write in the output folder"
+unwritable "$made" "$work/plain" "$sph" run "$tiny" --out "$work/plain" "${quick[@]}"
+unwritable "$made" "$work/plain/sub" "$sph" run "$tiny" --out "$work/plain/sub" "${quick[@]}"
+unwritable "$made" /proc/sph-no-such "$sph" run "$tiny" --out /proc/sph-no-such "${quick[@]}"
+unwritable "$written" /proc "$sph" run "$tiny" --out /proc --overwrite "${quick[@]}"
+unwritable "$written" /proc "$sph" study "$tiny" --vary time.end=0.01,0.02 --out /proc
+unwritable "$made" "$work/plain/r" "$sph" study "$tiny" --vary time.end=0.01,0.02 --out "$work/plain/r"
+if [ "$(id -u)" -ne 0 ]; then
+  mkdir -p "$work/ro" && chmod 555 "$work/ro"
+  unwritable "$written" "$work/ro" "$sph" run "$tiny" --out "$work/ro" "${quick[@]}"
+  unwritable "$made" "$work/ro/sub" "$sph" run "$tiny" --out "$work/ro/sub" "${quick[@]}"
+  chmod 755 "$work/ro"
+fi
+[ ! -e /proc/sph-no-such ] && [ -f "$work/plain" ] && [ ! -s "$work/plain" ] && ok ||
+  bad "an unwritable output folder: something was written"
 # a write failing mid-run (file size limit as a full disk): energy.csv
 # outgrows 4 KiB after about 15 rows
 (trap '' XFSZ; ulimit -f 4; "$sph" run "$tiny" --out "$work/e3" "${quick[@]}" \
@@ -159,6 +185,15 @@ rc=$?
   --set 'bodies.0.particles.count=[300,300,300]' 2>"$work/stderr" >/dev/null
 [ $? -eq 2 ] && grep -q "GB of memory is available" "$work/stderr" && ok ||
   bad "oversized run: $(cat "$work/stderr")"
+# or above --max-memory: the punch (693 particles) needs about 2 MB
+"$sph" check punch --max-memory 1M 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "the limit (--max-memory) is 0.001 GB" "$work/stderr" && ok ||
+  bad "--max-memory 1M: $(cat "$work/stderr")"
+"$sph" run punch --max-memory 1M --out "$work/mm" 2>/dev/null >/dev/null
+[ $? -eq 2 ] && [ ! -e "$work/mm" ] && ok || bad "run --max-memory 1M"
+"$sph" check punch --max-memory 5M >/dev/null 2>&1 && ok || bad "--max-memory 5M"
+"$sph" check punch --max-memory 5X 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "max-memory takes a size" "$work/stderr" && ok || bad "--max-memory 5X"
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -34,6 +34,13 @@ fi
 "$sph" render "$run" --out "$work/x" --field density 2>"$work/stderr" >/dev/null
 [ $? -eq 2 ] && grep -q "twisting_column_0000.vtp: no point array 'density' (it has: pressure" "$work/stderr" && ok ||
   bad "missing array: $(cat "$work/stderr")"
+# an output folder that cannot be made or written in (issue 21 item 13)
+touch "$work/plain"
+for out in "$work/plain/frames" /proc; do
+  "$sph" render "$run" --out "$out" 2>"$work/stderr" >/dev/null
+  [ $? -eq 2 ] && grep -qE "cannot (create|write in) the output folder $out: " "$work/stderr" && ok ||
+    bad "unwritable --out $out: $(cat "$work/stderr")"
+done
 # a damaged file (cut short) and a missing one
 head -c 2000 "$run/twisting_column_0003.vtp" >"$work/cut.vtp"
 mv "$work/cut.vtp" "$run/twisting_column_0003.vtp"

@@ -50,6 +50,9 @@ for f in energy.csv probes.csv twisting_column.pvd twisting_column_0300.vtp twis
   cmp -s "$work/whole/$f" "$work/term/$f" || fail "$f differs after the resume"
 done
 grep -q '"completed": true' "$work/term/summary.json" || fail "resumed run not completed"
+# how often each part ran is in the checkpoint (issue 21)
+[ "$(grep '"calls"' "$work/whole/summary.json")" = "$(grep '"calls"' "$work/term/summary.json")" ] ||
+  fail "summary.json calls differ after the resume: $(grep -h '"calls"' "$work/whole/summary.json" "$work/term/summary.json")"
 
 # frames: the follow camera and the colour range continue across a stop
 # and a resume (replayed from the .vtp files), so every frame equals the

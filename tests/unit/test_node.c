@@ -746,6 +746,94 @@ START_TEST(write_error_is_reported) {
 }
 END_TEST
 
+/* A path shortened for an error record keeps whole tokens only: a prefix
+ * of the path ending at a token's end, one ellipsis, a suffix starting at a
+ * token's start (issue 21 item 13: keys were cut mid-token) */
+static void assert_token_fit(const char *path, const char *got, size_t size) {
+  static const char ell[] = "\xe2\x80\xa6";
+  size_t len = strlen(path);
+  ck_assert_uint_lt(strlen(got), size);
+  if (len < size) {
+    ck_assert_str_eq(got, path);
+    return;
+  }
+  const char *e = strstr(got, ell);
+  ck_assert_msg(e != NULL, "'%s' from '%s': no ellipsis", got, path);
+  ck_assert_ptr_null(strstr(e + 3, ell));
+  size_t head = (size_t)(e - got);
+  const char *tail = e + 3;
+  if (head) { /* "<head>.…": <head> is a token-aligned prefix */
+    ck_assert_int_eq(got[head - 1], '.');
+    head -= 1;
+    ck_assert_msg(!strncmp(got, path, head) && strchr(".[", path[head]),
+                  "'%s' from '%s': head cut mid-token", got, path);
+  }
+  size_t tl = strlen(tail);
+  ck_assert_msg(tl == 0 || ((tail[0] == '.' || tail[0] == '[') &&
+                            !strcmp(path + len - tl, tail)),
+                "'%s' from '%s': tail cut mid-token", got, path);
+  ck_assert_uint_lt(head + tl, len); /* something was left out */
+}
+
+START_TEST(long_key_paths_are_cut_between_tokens) {
+  char got[128];
+  sph_key_path_fit(got, sizeof got, "bodies[0].shape.box.min");
+  ck_assert_str_eq(got, "bodies[0].shape.box.min");
+  char path[600];
+  snprintf(path, sizeof path, "bodies[0].shape.box.%0150d", 7);
+  sph_key_path_fit(got, sizeof got, path);
+  ck_assert_str_eq(got, "bodies[0].shape.box.\xe2\x80\xa6");
+  snprintf(path, sizeof path, "materials.%0150d.density", 7);
+  sph_key_path_fit(got, sizeof got, path);
+  ck_assert_str_eq(got, "materials.\xe2\x80\xa6.density");
+  snprintf(path, sizeof path, "%0200d.x", 7);
+  sph_key_path_fit(got, sizeof got, path);
+  ck_assert_str_eq(got, "\xe2\x80\xa6.x");
+  /* random paths of keys and indices, every record size */
+  srand(21);
+  for (int trial = 0; trial < 3000; ++trial) {
+    size_t n = 0;
+    int tokens = 1 + rand() % 12;
+    for (int k = 0; k < tokens && n < 400; ++k) {
+      if (k && rand() % 3 == 0)
+        n += (size_t)snprintf(path + n, sizeof path - n, "[%d]", rand() % 1000);
+      else {
+        n += (size_t)snprintf(path + n, sizeof path - n, "%s", k ? "." : "");
+        int kl = 1 + rand() % (rand() % 4 ? 12 : 90);
+        for (int c = 0; c < kl; ++c)
+          path[n++] = (char)('a' + rand() % 26);
+        path[n] = '\0';
+      }
+    }
+    size_t size = 4 + (size_t)(rand() % 124);
+    sph_key_path_fit(got, size, path);
+    assert_token_fit(path, got, size);
+  }
+  /* through the error record: an unknown key deep in a long path */
+  char yaml[1200];
+  snprintf(yaml, sizeof yaml,
+           "bodies:\n  - shape:\n      box:\n        %0140d:\n          "
+           "x: 1\n",
+           3);
+  sph_node *root = load(yaml);
+  sph_node *box = sph_node_child(
+      sph_node_child(sph_node_child(root, "bodies")->items[0], "shape"), "box");
+  static const char *const keys[] = {"min", "max", NULL};
+  sph_error err;
+  snprintf(path, sizeof path, "bodies[0].shape.box.%0140d", 3);
+  ck_assert_int_eq(sph_node_check_keys(box, keys, &err), SPH_ERR_UNKNOWN_KEY);
+  assert_token_fit(path, err.key, sizeof err.key);
+  ck_assert_str_eq(err.key, "bodies[0].shape.box.\xe2\x80\xa6");
+  sph_node_destroy(root);
+  /* a message too long for the record ends at a word with an ellipsis */
+  char word[1000];
+  memset(word, 'w', sizeof word - 1);
+  word[sizeof word - 1] = '\0';
+  sph_error_set(&err, SPH_ERR_ARG, "unknown key '%s' in bodies.0", word);
+  ck_assert_str_eq(err.message, "unknown key \xe2\x80\xa6");
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("node");
   TCase *tc = tcase_create("node");
@@ -763,6 +851,7 @@ int main(void) {
   tcase_add_test(tc, set_overrides);
   tcase_add_test(tc, write_load_round_trip);
   tcase_add_test(tc, write_error_is_reported);
+  tcase_add_test(tc, long_key_paths_are_cut_between_tokens);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }
