@@ -794,3 +794,11 @@ int tl_state_xpF(const tl_reference *ref, sph_state_array *out) {
   out[2] = (sph_state_array){"F", ref->F, 9 * ref->n};
   return 3;
 }
+
+int tl_leapfrog_state(const tl_reference *ref, const sph_leapfrog *lf,
+                      double *valid, sph_state_array *out) {
+  *valid = lf->have_rates;
+  out[0] = (sph_state_array){"rates", lf->dp, 3 * ref->n};
+  out[1] = (sph_state_array){"rates_valid", valid, 1};
+  return 2;
+}

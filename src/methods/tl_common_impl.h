@@ -198,6 +198,12 @@ sph_status tl_rk_acceleration(sph_sim *sim, const tl_reference *ref,
 /* The checkpointed state x, p and F of the real particles (method ops
  * `state`): returns 3. */
 int tl_state_xpF(const tl_reference *ref, sph_state_array *out);
+/* The leap-frog's cached rates (those of the current state, reused by the
+ * next step) and their validity as checkpoint state, so that a resumed run
+ * evaluates exactly what the uninterrupted one does; *valid mirrors
+ * lf->have_rates (restore: lf->have_rates = *valid). Returns 2. */
+int tl_leapfrog_state(const tl_reference *ref, const sph_leapfrog *lf,
+                      double *valid, sph_state_array *out);
 sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
                               sph_leapfrog *lf, const double *dp,
                               sph_error *err);

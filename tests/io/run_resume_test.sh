@@ -13,7 +13,7 @@ src=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # same_run: every file and summary number of a resumed run as an
-# uninterrupted one's (calls_warm=1: not the call counts)
+# uninterrupted one's
 . "$(dirname "$0")/compare_runs.sh"
 scene=$src/scenes/twisting_column.yaml
 check=(/usr/bin/python3 "$(dirname "$0")/check_vtk.py")
@@ -48,11 +48,11 @@ kill_and_resume() { # label, scene name, end, checkpoint interval, --set options
 kill_and_resume tl-jst twisting_column 0.3 0.02
 # tl-csph (no stabilisation) fractures at 0.175 s at the shipped 7 x 37 x 7
 # (3.07 dp): resumed at 5 x 25 x 5, where it stays stable to 0.3 s
-calls_warm=1 kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}' \
+kill_and_resume tl-csph twisting_column 0.3 0.02 --set 'method={name: tl-csph}' \
   --set 'bodies.0.particles.count=[5,25,5]'
 # ul-csph: the reference x^r, F^r and the steps since the update are state;
 # neighbours, corrections and the stabilisation are rebuilt from them
-calls_warm=1 kill_and_resume ul-csph bending_cylinder_ul_csph 0.3 0.05
+kill_and_resume ul-csph bending_cylinder_ul_csph 0.3 0.05
 # ul-sph: the configuration (neighbours, pair geometry) is rebuilt from the
 # checkpoint's positions of the last update
 kill_and_resume ul-sph colliding_rings 0.006 0.0005 \

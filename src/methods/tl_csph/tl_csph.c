@@ -123,7 +123,15 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 static int tl_csph_state(sph_sim *sim, sph_state_array *out) {
   tl_csph *m = sim->method_data;
   /* F of the last rates: the next time step's wave speed reads it */
-  return tl_state_xpF(&m->ref, out);
+  int k = tl_state_xpF(&m->ref, out);
+  return k + tl_leapfrog_state(&m->ref, &m->lf, &m->rates_valid, out + k);
+}
+
+static sph_status tl_csph_restore(sph_sim *sim, sph_error *err) {
+  tl_csph *m = sim->method_data;
+  m->lf.have_rates = m->rates_valid != 0.0;
+  (void)err;
+  return SPH_OK;
 }
 
 const sph_method_ops tl_csph_method_ops = {
@@ -138,5 +146,6 @@ const sph_method_ops tl_csph_method_ops = {
     .derive = tl_csph_derive,
     .energy = tl_csph_energy,
     .state = tl_csph_state,
+    .restore = tl_csph_restore,
     .destroy = tl_csph_destroy,
 };
