@@ -795,10 +795,8 @@ int tl_state_xpF(const tl_reference *ref, sph_state_array *out) {
   return 3;
 }
 
-int tl_leapfrog_state(const tl_reference *ref, const sph_leapfrog *lf,
-                      double *valid, sph_state_array *out) {
-  *valid = lf->have_rates;
-  out[0] = (sph_state_array){"rates", lf->dp, 3 * ref->n};
-  out[1] = (sph_state_array){"rates_valid", valid, 1};
-  return 2;
+sph_status tl_leapfrog_restore(sph_sim *sim, sph_leapfrog *lf, sph_error *err) {
+  SPH_TRY(lf->rates(lf->ctx, sim->t, err));
+  lf->have_rates = 1;
+  return SPH_OK;
 }

@@ -198,12 +198,10 @@ sph_status tl_rk_acceleration(sph_sim *sim, const tl_reference *ref,
 /* The checkpointed state x, p and F of the real particles (method ops
  * `state`): returns 3. */
 int tl_state_xpF(const tl_reference *ref, sph_state_array *out);
-/* The leap-frog's cached rates (those of the current state, reused by the
- * next step) and their validity as checkpoint state, so that a resumed run
- * evaluates exactly what the uninterrupted one does; *valid mirrors
- * lf->have_rates (restore: lf->have_rates = *valid). Returns 2. */
-int tl_leapfrog_state(const tl_reference *ref, const sph_leapfrog *lf,
-                      double *valid, sph_state_array *out);
+/* After a checkpoint has set the state: the rates of that state, which the
+ * next step reuses as the uninterrupted run's did (the checkpoint then
+ * restores the call counts, so this evaluation is not counted twice). */
+sph_status tl_leapfrog_restore(sph_sim *sim, sph_leapfrog *lf, sph_error *err);
 sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
                               sph_leapfrog *lf, const double *dp,
                               sph_error *err);

@@ -123,15 +123,12 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 static int tl_csph_state(sph_sim *sim, sph_state_array *out) {
   tl_csph *m = sim->method_data;
   /* F of the last rates: the next time step's wave speed reads it */
-  int k = tl_state_xpF(&m->ref, out);
-  return k + tl_leapfrog_state(&m->ref, &m->lf, &m->rates_valid, out + k);
+  return tl_state_xpF(&m->ref, out);
 }
 
 static sph_status tl_csph_restore(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
-  m->lf.have_rates = m->rates_valid != 0.0;
-  (void)err;
-  return SPH_OK;
+  return tl_leapfrog_restore(sim, &m->lf, err);
 }
 
 const sph_method_ops tl_csph_method_ops = {

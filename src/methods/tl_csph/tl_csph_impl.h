@@ -12,7 +12,6 @@ typedef struct tl_csph {
   double *x, *p, *F, *P;  /* particle fields */
   double *dp;             /* rate of momentum */
   sph_leapfrog lf;
-  double rates_valid; /* lf.have_rates in checkpoints */
   int timer_force;
   int timer_integration; /* the integrator's updates, the finite check */
   struct sph_sim *sim;

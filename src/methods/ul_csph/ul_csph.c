@@ -376,17 +376,18 @@ static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
   out[3] = (sph_state_array){"Xr", m->ref.X, 3 * ne};
   out[4] = (sph_state_array){"Fr", m->Fr, 9 * ne};
   out[5] = (sph_state_array){"since_update", &m->since, 1};
-  return 6 + tl_leapfrog_state(&m->ref, &m->lf, &m->rates_valid, out + 6);
+  return 6;
 }
 
 static sph_status ul_csph_restore(sph_sim *sim, sph_error *err) {
   ul_csph *m = sim->method_data;
   double t0 = sph_wtime();
   sph_status st = rebuild(m, err);
-  m->lf.have_rates = m->rates_valid != 0.0; /* of the restored reference */
   sim->timers[m->timer_update].seconds += sph_wtime() - t0;
   sim->timers[m->timer_update].calls++;
-  return st;
+  if (st != SPH_OK)
+    return st;
+  return tl_leapfrog_restore(sim, &m->lf, err);
 }
 
 const sph_method_ops ul_csph_method_ops = {

@@ -23,7 +23,6 @@ typedef struct ul_csph {
   double *x, *p, *F, *P; /* particle fields */
   double *dp;            /* rate of momentum */
   sph_leapfrog lf;
-  double rates_valid; /* lf.have_rates in checkpoints */
   int timer_force, timer_update, timer_integration;
   struct sph_sim *sim;
 } ul_csph;
