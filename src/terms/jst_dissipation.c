@@ -135,6 +135,13 @@ static const sph_term_ops jst_p_ops = {
     .destroy = jst_destroy,
 };
 
+static const sph_term_ops jst_p_sym_ops = {
+    .name = "jst_dissipation_p",
+    .reference = "seed 004 eq. 27-28 (symmetrised)",
+    .rates = jst_rates,
+    .destroy = jst_destroy,
+};
+
 static const sph_term_ops jst_j_ops = {
     .name = "jst_dissipation_J",
     .reference = "seed 000 eq. 35-38, projection eq. 51",
@@ -155,8 +162,11 @@ sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
     return sph_error_set(err, SPH_ERR_NOMEM, "JST work arrays");
   }
   j->p = *p;
-  sph_status st =
-      sph_sim_add_term(sim, p->ncomp == 3 ? &jst_p_ops : &jst_j_ops, j, err);
+  sph_status st = sph_sim_add_term(sim,
+                                   p->ncomp == 1 ? &jst_j_ops
+                                   : p->lap_sym  ? &jst_p_sym_ops
+                                                 : &jst_p_ops,
+                                   j, err);
   if (st != SPH_OK) {
     sph_term t = {.data = j};
     jst_destroy(&t);
