@@ -31,15 +31,16 @@ typedef struct sph_neighbors {
 
 /* Which pairs are kept. */
 typedef enum sph_pair_filter {
-  SPH_PAIRS_ALL = 0,      /* every pair within the radius */
-  SPH_PAIRS_SAME_BODY = 1 /* only pairs with body[a] == body[b] */
+  SPH_PAIRS_ALL = 0,       /* every pair within the radius */
+  SPH_PAIRS_SAME_BODY = 1, /* only pairs with body[a] == body[b] */
+  SPH_PAIRS_OTHER_BODY = 2 /* only pairs with body[a] != body[b] (contact) */
 } sph_pair_filter;
 
 sph_status sph_neighbors_create(sph_neighbors **out, sph_error *err);
 void sph_neighbors_destroy(sph_neighbors *nl);
 
 /* Builds the lists for n points x[3*i + c] in `dim` dimensions (components
- * beyond dim are ignored). `body` may be NULL unless filter is SAME_BODY. */
+ * beyond dim are ignored). `body` may be NULL when filter is ALL. */
 sph_status sph_neighbors_build(sph_neighbors *nl, const double *x, size_t n,
                                int dim, double radius, const int32_t *body,
                                sph_pair_filter filter, sph_error *err);

@@ -135,6 +135,33 @@ typedef struct sph_boundary {
   int line, col;
 } sph_boundary;
 
+/* A rigid frictionless obstacle of the optional `contact:` block, moving
+ * with a constant velocity: a plane the bodies stay in front of, or a box
+ * they stay outside of (the rigid tool of seed 001 sec. 2.4.3). */
+typedef enum sph_wall_kind { SPH_WALL_PLANE, SPH_WALL_BOX } sph_wall_kind;
+
+typedef struct sph_wall {
+  char name[SPH_NAME_MAX];
+  sph_wall_kind kind;
+  double point[3], normal[3]; /* plane through point at t = 0; bodies stay
+                                 where (x - point) . normal >= 0 */
+  double min[3], max[3];      /* box at t = 0 */
+  double velocity[3];
+  int line, col;
+} sph_wall;
+
+/* Penalty contact (src/terms/contact.c): walls, and between particles of
+ * different bodies when `between_bodies` is set. */
+typedef struct sph_contact {
+  int given;
+  double stiffness; /* kappa: the contact spring of a particle on a wall is
+                       that of a layer dp / (2 kappa) thick of its material */
+  int between_bodies;
+  sph_wall *walls;
+  size_t nwalls;
+  int line, col; /* of the contact block */
+} sph_contact;
+
 typedef struct sph_probe {
   char name[SPH_NAME_MAX];
   double at[3];
@@ -211,6 +238,7 @@ typedef struct sph_scene {
   size_t nboundaries;
   int has_body_force;
   double body_force[3]; /* acceleration, m/s^2 */
+  sph_contact contact;
   double t_end;
   sph_output output;
   sph_stability_options stability;
@@ -254,6 +282,11 @@ int sph_axis_index(const double n[3]);
  * `body`. */
 int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
                            int body, const double X[3]);
+
+/* Signed distance of x from wall w at time t (positive in front of a plane
+ * or outside a box) and the unit normal n pointing away from the wall. */
+double sph_wall_distance(const sph_wall *w, double t, int dim,
+                         const double x[3], double n[3]);
 
 /* Physical time of output frame `index`: min(time.end, index * every). */
 double sph_output_time(const sph_scene *s, int index);

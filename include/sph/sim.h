@@ -49,6 +49,8 @@ typedef struct sph_term_ops {
    * NULL); `state` has the same layout as a stage with rates unused */
   sph_status (*constrain)(sph_term *term, sph_sim *sim, sph_stage *state,
                           sph_error *err);
+  /* the largest step the term's own rates allow (may be NULL: no bound) */
+  double (*stable_dt)(sph_term *term, const sph_sim *sim);
   void (*destroy)(sph_term *term);
 } sph_term_ops;
 
@@ -133,6 +135,10 @@ const sph_method_ops *const *sph_method_list(void);
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err);
 void sph_sim_destroy(sph_sim *sim);
+
+/* The stable step of the current state: the method's, bounded by its
+ * terms' (contact springs). */
+double sph_sim_stable_dt(sph_sim *sim);
 
 /* Advances one step of at most dt_cap (so output times are hit exactly). */
 sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err);

@@ -39,7 +39,7 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
   for (int i = 0; i < sim->nterms; ++i)
     printf("  %-32s [%s]\n", sim->terms[i].ops->name,
            sim->terms[i].ops->reference);
-  double dt = sim->method->stable_dt(sim);
+  double dt = sph_sim_stable_dt(sim);
   double steps = dt > 0.0 ? s->t_end / dt : 0.0;
   printf("time       end %.6g s, first dt %.4g s, about %.0f steps\n", s->t_end,
          dt, steps);

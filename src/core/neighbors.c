@@ -72,8 +72,8 @@ static sph_status check_args(size_t n, int dim, double radius,
   if (!(radius > 0.0) || !isfinite(radius))
     return sph_error_set(err, SPH_ERR_ARG, "search radius %g is not positive",
                          radius);
-  if (filter == SPH_PAIRS_SAME_BODY && !body)
-    return sph_error_set(err, SPH_ERR_ARG, "same-body filter needs body ids");
+  if (filter != SPH_PAIRS_ALL && !body)
+    return sph_error_set(err, SPH_ERR_ARG, "a body filter needs body ids");
   if (n > (size_t)INT32_MAX)
     return sph_error_set(err, SPH_ERR_ARG, "%zu particles exceed 2^31", n);
   return SPH_OK;
@@ -81,7 +81,8 @@ static sph_status check_args(size_t n, int dim, double radius,
 
 static inline int pair_kept(const int32_t *body, sph_pair_filter filter,
                             size_t a, size_t b) {
-  return filter != SPH_PAIRS_SAME_BODY || body[a] == body[b];
+  return filter == SPH_PAIRS_ALL ||
+         (filter == SPH_PAIRS_SAME_BODY) == (body[a] == body[b]);
 }
 
 static inline double dist2(const double *x, size_t a, size_t b, int dim) {

@@ -714,6 +714,8 @@ tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
                        .ctx = ctx};
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, ref->rho0, err));
+  if (s->contact.given)
+    SPH_TRY(contact_create(sim, ref->rho0, err));
   if (sph_scene_has_essential_bc(s)) {
     SPH_TRY(essential_bc_create(sim, ref->rho0, err));
     SPH_TRY(constrain(ctx, 0.0, err));

@@ -1094,6 +1094,88 @@ static sph_status parse_stability(sph_scene *s, sph_node *root,
   return SPH_OK;
 }
 
+/* contact: {stiffness, between_bodies, walls: [{name, plane|box, velocity}]}
+ * (rigid frictionless walls and body-to-body contact, src/terms/contact.c) */
+static sph_status parse_contact(sph_scene *s, sph_node *root, sph_error *err) {
+  sph_node *c;
+  SPH_TRY(sph_node_get_map(root, "contact", 0, &c, err));
+  if (!c)
+    return SPH_OK;
+  sph_contact *ct = &s->contact;
+  static const char *const keys[] = {"stiffness", "between_bodies", "walls",
+                                     NULL};
+  SPH_TRY(sph_node_check_keys(c, keys, err));
+  ct->given = 1;
+  ct->line = c->line;
+  ct->col = c->col;
+  SPH_TRY(positive(c, "stiffness", 0, 1.0, &ct->stiffness, err));
+  SPH_TRY(
+      sph_node_get_bool(c, "between_bodies", 0, 0, &ct->between_bodies, err));
+  if (ct->between_bodies && s->nbodies < 2)
+    return sph_node_error(sph_node_child(c, "between_bodies"), err, SPH_ERR_ARG,
+                          "between_bodies needs two bodies or more, the scene "
+                          "has %zu",
+                          s->nbodies);
+  sph_node *list;
+  SPH_TRY(get_seq(c, "walls", 0, &list, err));
+  if (!list && !ct->between_bodies)
+    return sph_node_error(c, err, SPH_ERR_ARG,
+                          "contact with nothing: give walls or "
+                          "between_bodies: true");
+  size_t nw = list ? list->count : 0;
+  ct->walls = calloc(nw ? nw : 1, sizeof *ct->walls);
+  if (!ct->walls)
+    return sph_error_set(err, SPH_ERR_NOMEM, "walls");
+  static const char *const wkeys[] = {"name", "plane", "box", "velocity", NULL};
+  static const char *const kinds[] = {"plane", "box", NULL};
+  const size_t d = (size_t)s->dimension;
+  for (size_t i = 0; i < nw; ++i) {
+    sph_node *n = list->items[i];
+    sph_wall *w = &ct->walls[ct->nwalls++];
+    if (n->kind != SPH_NODE_MAP)
+      return sph_node_error(n, err, SPH_ERR_TYPE,
+                            "expected a wall (a mapping with name and plane "
+                            "or box)");
+    SPH_TRY(sph_node_check_keys(n, wkeys, err));
+    w->line = n->line;
+    w->col = n->col;
+    const char *name;
+    SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    copy_name(w->name, name);
+    int which;
+    SPH_TRY(one_of(n, kinds, "wall shape", &which, err));
+    sph_node *g;
+    SPH_TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
+    if (which == 0) {
+      static const char *const pkeys[] = {"point", "normal", NULL};
+      SPH_TRY(sph_node_check_keys(g, pkeys, err));
+      w->kind = SPH_WALL_PLANE;
+      SPH_TRY(sph_node_get_doubles(g, "point", 1, d, w->point, NULL, err));
+      SPH_TRY(get_direction(g, "normal", 1, 0, s->dimension, w->normal, err));
+    } else {
+      static const char *const bkeys[] = {"min", "max", NULL};
+      SPH_TRY(sph_node_check_keys(g, bkeys, err));
+      w->kind = SPH_WALL_BOX;
+      SPH_TRY(sph_node_get_doubles(g, "min", 1, d, w->min, NULL, err));
+      SPH_TRY(sph_node_get_doubles(g, "max", 1, d, w->max, NULL, err));
+      for (size_t k = 0; k < d; ++k)
+        if (!(w->max[k] > w->min[k]))
+          return sph_node_error(sph_node_child(g, "max"), err, SPH_ERR_GEOMETRY,
+                                "empty wall box: max <= min on axis %s",
+                                axis_names[k]);
+      if (d == 2) { /* plane strain: the box spans z */
+        w->min[2] = -INFINITY;
+        w->max[2] = INFINITY;
+      }
+    }
+    SPH_TRY(sph_node_get_doubles(n, "velocity", 0, 3, w->velocity, NULL, err));
+    if (d == 2 && w->velocity[2] != 0.0)
+      return sph_node_error(sph_node_child(n, "velocity"), err, SPH_ERR_RANGE,
+                            "a 2D scene's wall moves in x and y only");
+  }
+  return SPH_OK;
+}
+
 static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   if (root->kind != SPH_NODE_MAP)
     return sph_node_error(root, err, SPH_ERR_TYPE,
@@ -1102,7 +1184,7 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   static const char *const keys[] = {
       "name",      "dimension",  "method",     "kernel", "materials",
       "bodies",    "boundaries", "body_force", "time",   "output",
-      "reference", "stability",  NULL};
+      "reference", "stability",  "contact",    NULL};
   SPH_TRY(sph_node_check_keys(root, keys, err));
   const char *name;
   SPH_TRY(sph_node_get_string(root, "name", 1, NULL, &name, err));
@@ -1141,6 +1223,7 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
     SPH_TRY(sph_node_get_doubles(root, "body_force", 1, 3, s->body_force, NULL,
                                  err));
   }
+  SPH_TRY(parse_contact(s, root, err));
   SPH_TRY(parse_output(s, root, err));
   SPH_TRY(parse_stability(s, root, err));
   return SPH_OK;
@@ -1178,6 +1261,7 @@ void sph_scene_destroy(sph_scene *s) {
   free(s->bodies);
   free(s->materials);
   free(s->boundaries);
+  free(s->contact.walls);
   free(s->output.probes);
   sph_node_destroy(s->root);
   free(s);
@@ -1190,6 +1274,48 @@ int sph_scene_has_essential_bc(const sph_scene *s) {
         s->boundaries[k].kind == SPH_BC_VELOCITY)
       return 1;
   return 0;
+}
+
+double sph_wall_distance(const sph_wall *w, double t, int dim,
+                         const double x[3], double n[3]) {
+  double y[3]; /* x in the frame of the wall at t = 0 */
+  for (int c = 0; c < 3; ++c)
+    y[c] = c < dim ? x[c] - t * w->velocity[c] : 0.0;
+  if (w->kind == SPH_WALL_PLANE) {
+    double g = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      n[c] = w->normal[c];
+      g += (y[c] - w->point[c]) * n[c];
+    }
+    return g;
+  }
+  /* box: distance to the nearest point of its surface, negative inside */
+  double out[3], out2 = 0.0, depth = INFINITY;
+  int face = 0;
+  for (int c = 0; c < dim; ++c) {
+    out[c] = y[c] < w->min[c]   ? y[c] - w->min[c]
+             : y[c] > w->max[c] ? y[c] - w->max[c]
+                                : 0.0;
+    out2 += out[c] * out[c];
+    double lo = y[c] - w->min[c], hi = w->max[c] - y[c];
+    if (lo < depth) {
+      depth = lo;
+      face = -(c + 1);
+    }
+    if (hi < depth) {
+      depth = hi;
+      face = c + 1;
+    }
+  }
+  n[0] = n[1] = n[2] = 0.0;
+  if (out2 > 0.0) {
+    double g = sqrt(out2);
+    for (int c = 0; c < dim; ++c)
+      n[c] = out[c] / g;
+    return g;
+  }
+  n[abs(face) - 1] = face > 0 ? 1.0 : -1.0;
+  return -depth;
 }
 
 double sph_output_time(const sph_scene *s, int index) {
@@ -1470,6 +1596,24 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
                         "probe '%s' at (%g, %g, %g) is outside every body",
                         p->name, p->at[0], p->at[1],
                         s->dimension == 3 ? p->at[2] : 0.0);
+    }
+  }
+  /* walls: no particle starts behind one */
+  for (size_t k = 0; st == SPH_OK && k < s->contact.nwalls; ++k) {
+    const sph_wall *w = &s->contact.walls[k];
+    for (size_t i = 0; i < ps->n; ++i) {
+      double nrm[3],
+          g = sph_wall_distance(w, 0.0, s->dimension,
+                                ps->field[SPH_FIELD_POSITION0] + 3 * i, nrm);
+      if (g >= 0.0)
+        continue;
+      char key[48];
+      snprintf(key, sizeof key, "contact.walls[%zu]", k);
+      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, w->line, w->col, key,
+                        "body '%s' starts inside wall '%s' (a particle %g m "
+                        "beyond it)",
+                        s->bodies[ps->body[i]].name, w->name, -g);
+      break;
     }
   }
   if (st != SPH_OK) {

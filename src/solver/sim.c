@@ -192,9 +192,17 @@ void sph_sim_destroy(sph_sim *sim) {
   free(sim);
 }
 
+double sph_sim_stable_dt(sph_sim *sim) {
+  double dt = sim->method->stable_dt(sim);
+  for (int i = 0; i < sim->nterms; ++i)
+    if (sim->terms[i].ops->stable_dt)
+      dt = fmin(dt, sim->terms[i].ops->stable_dt(&sim->terms[i], sim));
+  return dt;
+}
+
 sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
   double t0 = sph_wtime();
-  double dt = sim->method->stable_dt(sim);
+  double dt = sph_sim_stable_dt(sim);
   sim->timers[sim->timer_stable_dt].seconds += sph_wtime() - t0;
   sim->timers[sim->timer_stable_dt].calls++;
   if (!(dt > 0.0) || !isfinite(dt))

@@ -46,6 +46,11 @@ sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
  * rho0 is NULL: updated methods integrate the velocity). */
 sph_status body_force_create(sph_sim *sim, const double *rho0, sph_error *err);
 
+/* Frictionless penalty contact with the scene's walls and, when asked,
+ * between particles of different bodies (seed 001 sec. 2.4.2-2.4.3): adds
+ * force / V0 to dp (force / mass when rho0 is NULL) and bounds the step. */
+sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err);
+
 /* Essential boundary conditions imposed directly on particles (seed 000
  * Algorithm 1 step 8): clamp, roller, prescribed velocity over a window.
  * Acts on momentum per reference volume (p = rho0 v), or on the velocity

@@ -138,6 +138,7 @@ START_TEST(same_body_filter) {
     body[i] = (int32_t)(i % 3);
   }
   compare(x, n, 2, 0.08, body, SPH_PAIRS_SAME_BODY);
+  compare(x, n, 2, 0.08, body, SPH_PAIRS_OTHER_BODY);
   compare(x, n, 2, 0.08, body, SPH_PAIRS_ALL);
   sph_neighbors *nl;
   sph_error err;
@@ -145,11 +146,25 @@ START_TEST(same_body_filter) {
   ck_assert_int_eq(
       sph_neighbors_build(nl, x, n, 2, 0.08, body, SPH_PAIRS_SAME_BODY, &err),
       SPH_OK);
-  size_t cross = 0;
+  size_t cross = 0, same = 0, pairs = nl->count;
   for (size_t a = 0; a < n; ++a)
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k)
       cross += body[nl->index[k]] != body[a];
   ck_assert_uint_eq(cross, 0);
+  /* the contact filter keeps exactly the other pairs */
+  ck_assert_int_eq(
+      sph_neighbors_build(nl, x, n, 2, 0.08, body, SPH_PAIRS_OTHER_BODY, &err),
+      SPH_OK);
+  for (size_t a = 0; a < n; ++a)
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k)
+      same += body[nl->index[k]] == body[a];
+  ck_assert_uint_eq(same, 0);
+  size_t others = nl->count;
+  ck_assert_uint_gt(others, 0);
+  ck_assert_int_eq(
+      sph_neighbors_build(nl, x, n, 2, 0.08, NULL, SPH_PAIRS_ALL, &err),
+      SPH_OK);
+  ck_assert_uint_eq(nl->count, pairs + others);
   sph_neighbors_destroy(nl);
   free(x);
   free(body);

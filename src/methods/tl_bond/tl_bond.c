@@ -371,6 +371,8 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   }
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, m->ref.rho0, err));
+  if (s->contact.given)
+    SPH_TRY(contact_create(sim, m->ref.rho0, err));
   if (sph_scene_has_essential_bc(s)) {
     SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
     /* the initial state honours the constraints */

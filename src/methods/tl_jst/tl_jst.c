@@ -441,6 +441,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   }
   if (s->has_body_force)
     SPH_TRY(body_force_create(sim, m->ref.rho0, err));
+  if (s->contact.given)
+    SPH_TRY(contact_create(sim, m->ref.rho0, err));
   int planes = 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||

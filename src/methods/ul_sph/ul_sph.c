@@ -533,6 +533,13 @@ static sph_status check_scene(const sph_scene *s, sph_error *err) {
                           "planes; use a roller",
                           b->name);
   }
+  /* its acoustic sub-steps are not bounded by the contact spring */
+  if (s->contact.given)
+    return sph_error_at(err, SPH_ERR_ARG, s->path, s->contact.line,
+                        s->contact.col, "contact",
+                        "ul-sph has no contact term: its bodies already "
+                        "touch through the Riemann pressure (seed 002 "
+                        "sec. 6.3), and walls are not implemented for it");
   return SPH_OK;
 }
 

@@ -1,0 +1,230 @@
+/* Frictionless contact by a penalty force: rigid walls (a symmetry plane
+ * between two colliding bodies, seed 001 sec. 2.4.2; the rigid tool of the
+ * punch, sec. 2.4.3) and particles of different bodies (the two rubber
+ * rings, sec. 2.4.2, where the total-Lagrangian neighbour lists never join
+ * bodies). The papers impose the contact exactly; here it is a spring that
+ * acts along the normal while a particle is closer than r_c:
+ *   f = kappa M A (r_c - r) / r_c,
+ * M = lambda + 2 mu the p-wave modulus (harmonic mean across a pair), A the
+ * area a particle presents (V0 / dp), r_c = dp / 2 to a wall and
+ * (dp_a + dp_b) / 2 between particles. Mirrored about a wall, a pair of
+ * particles feels exactly the wall's force. The force is conservative and
+ * equal and opposite across a pair, so momentum is kept to round-off; the
+ * spring bounds the time step (term_stable_dt). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sph/material.h"
+#include "terms/terms_impl.h"
+
+typedef struct contact {
+  size_t n;
+  int dim;
+  const sph_contact *spec;
+  double kappa;
+  double *inv_mass; /* 1 / V0 (dp is a momentum rate) or 1 / m */
+  double *modulus;  /* lambda + 2 mu of the particle's material */
+  double *area;     /* V0 / dp */
+  double *spacing;  /* dp of the particle's body */
+  double dt_bound;
+  /* between bodies: the particles near another body, their positions and
+   * bodies gathered for the search, and the pairs closer than `radius` */
+  int between;
+  int nbodies;
+  double radius;
+  double *box; /* per body: min[3], max[3] of the stage positions */
+  size_t *cand;
+  double *xc;
+  int32_t *bc;
+  sph_neighbors *nl;
+} contact;
+
+/* A particle of body b within `pad` of the box of another body. */
+static int near_other_body(const contact *ct, const double *x, int b,
+                           double pad) {
+  for (int o = 0; o < ct->nbodies; ++o) {
+    if (o == b)
+      continue;
+    const double *lo = ct->box + 6 * o, *hi = lo + 3;
+    int in = 1;
+    for (int c = 0; c < ct->dim && in; ++c)
+      in = x[c] > lo[c] - pad && x[c] < hi[c] + pad;
+    if (in)
+      return 1;
+  }
+  return 0;
+}
+
+/* the pair forces of particles near another body, into dp */
+static sph_status between_bodies(contact *ct, const sph_sim *sim,
+                                 sph_stage *stage, sph_error *err) {
+  const double *x = stage->x;
+  const int32_t *body = sim->ps->body;
+  for (int b = 0; b < ct->nbodies; ++b)
+    for (int c = 0; c < 3; ++c) {
+      ct->box[6 * b + c] = INFINITY;
+      ct->box[6 * b + 3 + c] = -INFINITY;
+    }
+  for (size_t a = 0; a < ct->n; ++a)
+    for (int c = 0; c < 3; ++c) {
+      double *bx = ct->box + 6 * body[a];
+      bx[c] = fmin(bx[c], x[3 * a + c]);
+      bx[3 + c] = fmax(bx[3 + c], x[3 * a + c]);
+    }
+  size_t nc = 0;
+  for (size_t a = 0; a < ct->n; ++a)
+    if (near_other_body(ct, x + 3 * a, body[a], ct->radius)) {
+      ct->cand[nc] = a;
+      memcpy(ct->xc + 3 * nc, x + 3 * a, 3 * sizeof *x);
+      ct->bc[nc++] = body[a];
+    }
+  if (nc < 2)
+    return SPH_OK;
+  SPH_TRY(sph_neighbors_build(ct->nl, ct->xc, nc, ct->dim, ct->radius, ct->bc,
+                              SPH_PAIRS_OTHER_BODY, err));
+  const sph_neighbors *nl = ct->nl;
+  const double kappa = ct->kappa;
+  double *dp = stage->dp;
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < nc; ++i) {
+    size_t a = ct->cand[i];
+    double f[3] = {0, 0, 0};
+    for (size_t s = nl->offset[i]; s < nl->offset[i + 1]; ++s) {
+      size_t j = (size_t)nl->index[s], b = ct->cand[j];
+      double e[3], r2 = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        e[c] = x[3 * a + c] - x[3 * b + c];
+        r2 += e[c] * e[c];
+      }
+      double r = sqrt(r2), rc = 0.5 * (ct->spacing[a] + ct->spacing[b]);
+      if (!(r < rc) || r == 0.0)
+        continue;
+      double M = 2.0 * ct->modulus[a] * ct->modulus[b] /
+                 (ct->modulus[a] + ct->modulus[b]);
+      double A = 0.5 * (ct->area[a] + ct->area[b]);
+      double mag = kappa * M * A * (rc - r) / (rc * r);
+      for (int c = 0; c < 3; ++c)
+        f[c] += mag * e[c];
+    }
+    for (int c = 0; c < 3; ++c)
+      dp[3 * a + c] += ct->inv_mass[a] * f[c];
+  }
+  return SPH_OK;
+}
+
+static sph_status contact_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
+                                sph_error *err) {
+  contact *ct = term->data;
+  const sph_contact *spec = ct->spec;
+  const double *x = stage->x;
+  double *dp = stage->dp;
+  const double t = stage->t, kappa = ct->kappa;
+  const int dim = ct->dim;
+  if (spec->nwalls) {
+#pragma omp parallel for schedule(static)
+    for (size_t a = 0; a < ct->n; ++a) {
+      double rc = 0.5 * ct->spacing[a];
+      for (size_t w = 0; w < spec->nwalls; ++w) {
+        double nrm[3],
+            g = sph_wall_distance(&spec->walls[w], t, dim, x + 3 * a, nrm);
+        if (!(g < rc))
+          continue;
+        double mag = kappa * ct->modulus[a] * ct->area[a] * (rc - g) / rc;
+        for (int c = 0; c < 3; ++c)
+          dp[3 * a + c] += ct->inv_mass[a] * mag * nrm[c];
+      }
+    }
+  }
+  if (ct->between)
+    SPH_TRY(between_bodies(ct, sim, stage, err));
+  return SPH_OK;
+}
+
+static double contact_stable_dt(sph_term *term, const sph_sim *sim) {
+  (void)sim;
+  return ((contact *)term->data)->dt_bound;
+}
+
+static void contact_destroy(sph_term *term) {
+  contact *ct = term->data;
+  if (!ct)
+    return;
+  free(ct->inv_mass);
+  free(ct->modulus);
+  free(ct->area);
+  free(ct->spacing);
+  free(ct->box);
+  free(ct->cand);
+  free(ct->xc);
+  free(ct->bc);
+  sph_neighbors_destroy(ct->nl);
+  free(ct);
+}
+
+static const sph_term_ops contact_ops = {
+    .name = "contact",
+    .reference = "seed 001 sec. 2.4.2-2.4.3 (frictionless contact, penalty)",
+    .rates = contact_rates,
+    .stable_dt = contact_stable_dt,
+    .destroy = contact_destroy,
+};
+
+sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_particles *ps = sim->ps;
+  const size_t n = ps->n, nn = n ? n : 1;
+  contact *ct = calloc(1, sizeof *ct);
+  sph_term t = {.data = ct};
+  if (!ct)
+    return sph_error_set(err, SPH_ERR_NOMEM, "contact");
+  ct->n = n;
+  ct->dim = s->dimension;
+  ct->spec = &s->contact;
+  ct->kappa = s->contact.stiffness;
+  ct->between = s->contact.between_bodies;
+  ct->nbodies = (int)s->nbodies;
+  ct->inv_mass = malloc(nn * sizeof *ct->inv_mass);
+  ct->modulus = malloc(nn * sizeof *ct->modulus);
+  ct->area = malloc(nn * sizeof *ct->area);
+  ct->spacing = malloc(nn * sizeof *ct->spacing);
+  if (!ct->inv_mass || !ct->modulus || !ct->area || !ct->spacing) {
+    contact_destroy(&t);
+    return sph_error_set(err, SPH_ERR_NOMEM, "contact");
+  }
+  /* the contact spring of a particle (at most about four springs' worth
+   * between bodies, two on a wall) stays below 1 / dt */
+  double omega2 = 0.0;
+  const double *V0 = ps->field[SPH_FIELD_VOLUME0];
+  for (size_t a = 0; a < n; ++a) {
+    const sph_body *b = &s->bodies[ps->body[a]];
+    const sph_material *mat = &s->materials[b->material];
+    ct->spacing[a] = b->spacing;
+    ct->modulus[a] = mat->lambda + 2.0 * mat->mu;
+    ct->area[a] = V0[a] / b->spacing;
+    double mass = mat->density * V0[a];
+    ct->inv_mass[a] = rho0 ? 1.0 / V0[a] : 1.0 / mass;
+    double k = ct->kappa * ct->modulus[a] * ct->area[a] / (0.5 * b->spacing);
+    omega2 = fmax(omega2, 2.0 * k / mass);
+  }
+  ct->dt_bound = omega2 > 0.0 ? 1.0 / sqrt(omega2) : INFINITY;
+  if (ct->between) {
+    for (size_t k = 0; k < s->nbodies; ++k)
+      ct->radius = fmax(ct->radius, s->bodies[k].spacing);
+    ct->box = malloc(6 * s->nbodies * sizeof *ct->box);
+    ct->cand = malloc(nn * sizeof *ct->cand);
+    ct->xc = malloc(3 * nn * sizeof *ct->xc);
+    ct->bc = malloc(nn * sizeof *ct->bc);
+    sph_status st = !ct->box || !ct->cand || !ct->xc || !ct->bc
+                        ? sph_error_set(err, SPH_ERR_NOMEM, "contact")
+                        : sph_neighbors_create(&ct->nl, err);
+    if (st != SPH_OK) {
+      contact_destroy(&t);
+      return st;
+    }
+  }
+  sph_status st = sph_sim_add_term(sim, &contact_ops, ct, err);
+  if (st != SPH_OK)
+    contact_destroy(&t);
+  return st;
+}
