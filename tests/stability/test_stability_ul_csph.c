@@ -160,7 +160,7 @@ START_TEST(rubber_rings) {
   /* tl-csph keeps the mirror symmetry and only mirror twins come closer
    * than dp, so the second ring acts exactly as the plane: the same history
    * to round-off (measured 2.6e-13 m). ul-csph does not keep the symmetry
-   * (measured 4.9e-3 m apart, docs/results.md) */
+   * (measured 4.9e-3 m apart): eq. 21 stabilises along h = (h, h, h) */
   ck_assert_double_le(d_tl, 1e-9);
   /* the paper's eta = 0.3 at five particles across: initially adjacent
    * particles at the bottom of the ring part (measured 2.05 dp at 0.025 s),
