@@ -163,11 +163,20 @@ static void print_sink_times(const sph_sink *sinks, int nsinks, double wall) {
   printf(" of %.2f s wall\n", wall);
 }
 
-/* derive, then every sink and the verdict see the same frame */
-static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
-                               sph_verdict *v, int index, sph_error *err) {
+/* Over MPI ranks every rank writes its VTK piece; the other sinks run on
+ * rank 0 only. */
+static int piece_sink(const sph_sim *sim, const sph_sink *sink) {
+  return sim->domain && sink->ops == &sph_vtk_sink_ops;
+}
+
+/* derive, then every sink and the verdict see the same frame; over MPI
+ * ranks the energies are summed over them and the fields gathered to rank
+ * 0, where `view` is the run seen whole (rank 0's sinks and verdict) */
+static sph_status output_frame(sph_sim *sim, sph_sim *view, sph_sink *sinks,
+                               int nsinks, sph_verdict *v, int index,
+                               sph_error *err) {
   sph_status st = sim->method->derive(sim, err);
-  if (st != SPH_OK)
+  if ((st = sph_domain_agree(sim->domain, st, err)) != SPH_OK)
     return st;
   sph_frame fr = {.time = sim->t,
                   .step = sim->steps,
@@ -175,15 +184,37 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
                   .sim = sim,
                   .ps = sim->ps};
   sim->method->energy(sim, &fr.kinetic, &fr.strain);
-  for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+  sph_frame whole = fr;
+  int root = sph_domain_rank(sim->domain) == 0;
+  if (sim->domain) {
+    double e[2] = {fr.kinetic, fr.strain};
+    sph_domain_sum(sim->domain, e, 2);
+    fr.kinetic = whole.kinetic = e[0];
+    fr.strain = whole.strain = e[1];
+    SPH_TRY(sph_domain_gather(sim->domain, sim->ps, err));
+    if (root) {
+      sph_particles *all = view->ps;
+      *view = *sim;
+      view->ps = all;
+      whole.sim = view;
+      whole.ps = all;
+    }
+  }
+  for (int i = 0; i < nsinks; ++i) {
+    int piece = piece_sink(sim, &sinks[i]);
+    if ((st != SPH_OK && !piece) || (!root && !piece))
+      continue; /* pieces are collective: every rank writes its own */
     double t0 = sph_wtime();
-    st = sinks[i].ops->write(&sinks[i], &fr, err);
+    sph_status sst = sinks[i].ops->write(&sinks[i], piece ? &fr : &whole, err);
+    st = st == SPH_OK ? sst : st;
     sinks[i].seconds += sph_wtime() - t0;
   }
-  if (st == SPH_OK)
-    st = sph_verdict_observe(v, &fr, err);
+  if (st == SPH_OK && root)
+    st = sph_verdict_observe(v, &whole, err);
   if (st == SPH_OK && sim->reference)
     sph_reference_observe(sim->reference, &fr);
+  st = sph_domain_agree(sim->domain, st, err);
+  v->stable = sph_domain_bcast_int(sim->domain, v->stable);
   return st;
 }
 
@@ -267,6 +298,10 @@ int sph_cmd_run(int argc, char **argv) {
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   const char *path = args.scene ? args.scene : sph_app_default_scene();
+  /* over MPI ranks rank 0 prints for all */
+  int root = sph_domain_world_rank() == 0;
+  if (!root && !freopen("/dev/null", "w", stdout))
+    return SPH_EXIT_IO;
   sph_scene *scene;
   sph_sim *sim;
   if ((rc = sph_app_load(&args, path, &scene, &sim)) != SPH_EXIT_OK)
@@ -275,6 +310,19 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error_clear(&err);
   sph_status st = SPH_OK;
   char dir[1024];
+  /* rank 0's view of a distributed run: every particle, gathered */
+  sph_sim view = *sim;
+  if (sim->domain && root)
+    view.ps = sph_domain_global(sim->domain);
+  const sph_sim *whole = sim->domain ? &view : sim;
+  if (args.resume && sim->domain) {
+    if (root)
+      fprintf(stderr, "sph: --resume does not run over MPI ranks yet; "
+                      "resume without mpirun\n");
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
   if (args.resume && args.out && strcmp(args.resume, args.out)) {
     fprintf(stderr, "sph: --resume continues in its own folder; drop --out "
                     "or give the same folder\n");
@@ -302,12 +350,14 @@ int sph_cmd_run(int argc, char **argv) {
   long holder = 0;
   int lock_fd = -1;
   struct stat rst;
-  if (args.resume && stat(dir, &rst) != 0) /* not made for a resume */
+  if (!root)
+    ; /* rank 0 makes, locks and checks the folder for every rank */
+  else if (args.resume && stat(dir, &rst) != 0) /* not made for a resume */
     st = sph_error_set(&err, SPH_ERR_ARG, "nothing to resume in %s: %s", dir,
                        strerror(errno));
   else
     st = sph_app_output_dir(dir, &err);
-  if (st == SPH_OK && (lock_fd = lock_output(dir, &holder)) < 0) {
+  if (st == SPH_OK && root && (lock_fd = lock_output(dir, &holder)) < 0) {
     if (holder > 0)
       st = sph_error_set(&err, SPH_ERR_ARG,
                          "%s is in use by another sph run (pid %ld); wait for "
@@ -319,13 +369,14 @@ int sph_cmd_run(int argc, char **argv) {
                          strerror(errno));
   }
   /* after the lock: a folder in use says so, whatever it holds */
-  if (st == SPH_OK && !args.overwrite && !args.resume &&
+  if (st == SPH_OK && root && !args.overwrite && !args.resume &&
       (file_exists(dir, "summary.json") || file_exists(dir, "scene_used.yaml")))
     st = sph_error_set(&err, SPH_ERR_ARG,
                        "%s holds the results of an earlier run; pass "
                        "--overwrite to replace them or --out DIR to write "
                        "elsewhere",
                        dir);
+  st = sph_domain_agree(sim->domain, st, &err);
   if (st != SPH_OK) {
     sph_app_print_error(&err);
     if (lock_fd >= 0)
@@ -334,10 +385,10 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  if (args.overwrite && !args.resume)
+  if (args.overwrite && !args.resume && root)
     remove_previous(dir, scene->name);
   if (!args.quiet)
-    banner(sim, dir);
+    banner(whole, dir);
 
   sph_sink sinks[4];
   int nsinks = 0;
@@ -355,7 +406,7 @@ int sph_cmd_run(int argc, char **argv) {
   }
   sph_verdict *verdict = NULL;
   int index = 0;
-  st = sph_verdict_create(&verdict, sim, &err);
+  st = sph_verdict_create(&verdict, root ? whole : sim, &err);
   if (st == SPH_OK && args.resume) {
     char used[1200];
     st = sph_checkpoint_resume(dir, sim, verdict, &index, used, sizeof used,
@@ -371,22 +422,28 @@ int sph_cmd_run(int argc, char **argv) {
       printf("  resume     %s: t = %.6g s, step %lu, next output %d\n", used,
              sim->t, sim->steps, index);
   }
-  if (st == SPH_OK)
+  if (st == SPH_OK && root)
     st = write_scene_used(scene, dir, &err);
   for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+    int piece = piece_sink(sim, &sinks[i]);
+    if (!root && !piece)
+      continue;
     double t0 = sph_wtime();
     sinks[i].resume_frames = index;
-    st = sinks[i].ops->open(&sinks[i], sim, dir, &err);
+    st = sinks[i].ops->open(&sinks[i], piece ? sim : whole, dir, &err);
     sinks[i].seconds += sph_wtime() - t0;
   }
+  st = sph_domain_agree(sim->domain, st, &err);
 
-  catch_stop_signals();
+  /* over MPI ranks a signal ends every rank at once (no checkpoints yet) */
+  if (!sim->domain)
+    catch_stop_signals();
   sph_progress prog;
-  sph_progress_start(&prog, scene->t_end, args.quiet);
+  sph_progress_start(&prog, scene->t_end, args.quiet || !root);
   double wall0 = sph_wtime();
   int completed = 0;
   if (st == SPH_OK && index == 0)
-    st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
+    st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
   double t_end = scene->t_end, ckpt = scene->output.checkpoint_every;
   double eps = 1e-12 * t_end;
   double next_ckpt =
@@ -400,7 +457,7 @@ int sph_cmd_run(int argc, char **argv) {
     sph_progress_step(&prog, sim->t, sim->steps);
     if (sim->t >= next - eps) {
       sim->t = next; /* land exactly on the output time */
-      st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
+      st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
       sph_progress_output(&prog, sim->t, sim->steps);
     }
     if (st == SPH_OK && sim->t >= next_ckpt - eps && sim->t < t_end - eps) {
@@ -455,16 +512,19 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error merr;
   sph_status mst = SPH_OK;
   int mp4_tried = scene->output.png.enabled && scene->output.png.mp4 &&
-                  !io_failed && index > 0;
+                  !io_failed && index > 0 && root;
   if (mp4_tried)
     mst = sph_mp4_assemble(dir, scene->name, index, scene->output.png.fps, &mp4,
                            &merr);
-  if (verdict && !io_failed) {
+  if (verdict && !io_failed && root) {
     char spath[1200];
     snprintf(spath, sizeof spath, "%s/summary.json", dir);
     sph_provenance prov;
     sph_app_provenance(&prov);
-    if (sph_summary_write(spath, sim, &prov, verdict, wall, sinks, nsinks,
+    sph_particles *all = view.ps;
+    view = *sim; /* the counts and timers of the end of the run */
+    view.ps = all;
+    if (sph_summary_write(spath, whole, &prov, verdict, wall, sinks, nsinks,
                           mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
                           completed, stopped ? signal_name(stopped) : NULL,
                           &cerr) != SPH_OK) {
@@ -489,7 +549,7 @@ int sph_cmd_run(int argc, char **argv) {
   } else {
     printf("verdict: stable (%lu steps, %.2f s wall, %.3g particle-steps/s)\n",
            sim->steps, wall,
-           wall > 0 ? (double)sim->steps * (double)sim->ps->n / wall : 0.0);
+           wall > 0 ? (double)sim->steps * (double)whole->ps->n / wall : 0.0);
     rc = SPH_EXIT_OK;
   }
   if (!io_failed && !args.quiet)
@@ -504,9 +564,11 @@ int sph_cmd_run(int argc, char **argv) {
     sph_error_format(&merr, msg, sizeof msg);
     fprintf(stderr, "sph: warning: no mp4: %s\n", msg);
   }
+  rc = sph_domain_bcast_int(sim->domain, rc); /* rank 0's verdict */
   sph_verdict_destroy(verdict);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
-  close(lock_fd); /* the folder is free for the next run */
+  if (lock_fd >= 0)
+    close(lock_fd); /* the folder is free for the next run */
   return rc;
 }
