@@ -48,9 +48,13 @@ const double *sph_domain_ghost_X(const sph_domain *d);
 const double *sph_domain_ghost_volume(const sph_domain *d);
 const int32_t *sph_domain_ghost_body(const sph_domain *d);
 const int64_t *sph_domain_ghost_id(const sph_domain *d);
-/* Halo bytes and messages this rank sends per exchange of one double per
- * ghost (the measured halo volume). */
-void sph_domain_halo(const sph_domain *d, size_t *doubles, int *messages);
+/* The halo over all ranks (collective): values sent per exchange of one
+ * double per ghost (the ghosts of every rank), messages per exchange, and
+ * the most ghosts and owned particles of a rank. */
+typedef struct sph_halo {
+  double values, messages, max_ghosts, max_owned;
+} sph_halo;
+sph_halo sph_domain_halo(const sph_domain *d);
 
 /* Sorts each of the first n lists of nl, built over the owned particles
  * followed by the ghosts, by the particles' storage index in the whole set:

@@ -47,6 +47,18 @@ static int run_file(const char *name, const char *scene, const char *suffix,
   return !strcmp(rest, suffix);
 }
 
+/* name is a VTK piece of a run over MPI ranks, <scene>_NNNN_pR.vtp[.part] */
+static int piece_file(const char *name, const char *scene) {
+  size_t p = strlen(scene);
+  if (strncmp(name, scene, p) || name[p] != '_' ||
+      strspn(name + p + 1, "0123456789") != 4 || strncmp(name + p + 5, "_p", 2))
+    return 0;
+  const char *rest = name + p + 7;
+  size_t digits = strspn(rest, "0123456789");
+  return digits > 0 && (!strcmp(rest + digits, ".vtp") ||
+                        !strcmp(rest + digits, ".vtp.part"));
+}
+
 /* Removes the files in dir that the run named `scene` writes, and its
  * temporary (.part) ones. */
 static void remove_run_files(const char *dir, const char *scene) {
@@ -57,8 +69,8 @@ static void remove_run_files(const char *dir, const char *scene) {
                                       SPH_CHECKPOINT_FILE,
                                       SPH_CHECKPOINT_PREVIOUS,
                                       NULL};
-  static const char *const numbered[] = {".vtp", ".vtp.part", ".png",
-                                         ".png.part", NULL};
+  static const char *const numbered[] = {
+      ".vtp", ".vtp.part", ".pvtp", ".pvtp.part", ".png", ".png.part", NULL};
   static const char *const single[] = {".pvd", ".pvd.part", ".mp4", ".mp4.part",
                                        NULL};
   char path[2400];
@@ -79,6 +91,7 @@ static void remove_run_files(const char *dir, const char *scene) {
         ours = run_file(e->d_name, scene, *x, 1);
       for (const char *const *x = single; *x && !ours && k == 0; ++x)
         ours = run_file(e->d_name, scene, *x, 0);
+      ours = ours || (k == 0 && piece_file(e->d_name, scene));
       if (!ours)
         continue;
       snprintf(path, sizeof path, "%s/%s", sub[k], e->d_name);
@@ -109,7 +122,7 @@ static void remove_previous(const char *dir, const char *scene) {
   remove_run_files(dir, scene);
 }
 
-static void banner(const sph_sim *sim, const char *dir) {
+static void banner(const sph_sim *sim, const char *dir, const sph_halo *h) {
   const sph_scene *s = sim->scene;
   printf("sph: %s (%s)\n", s->name, s->path);
   printf("  method     %s: %s\n             [%s]\n", sim->method->name,
@@ -124,6 +137,12 @@ static void banner(const sph_sim *sim, const char *dir) {
     printf(" %s", sim->terms[i].ops->name);
   printf("\n  time       0 .. %.6g s, output every %.6g s, %d thread%s\n",
          s->t_end, s->output.every, sim->threads, sim->threads == 1 ? "" : "s");
+  if (sim->domain)
+    printf("  ranks      %d (MPI, recursive coordinate bisection): at most "
+           "%.0f owned and %.0f ghost particles a rank; halo %.0f particles "
+           "in %.0f messages per exchange\n",
+           sph_domain_size(sim->domain), h->max_owned, h->max_ghosts, h->values,
+           h->messages);
   printf("  output     %s/\n", dir);
   fflush(stdout);
 }
@@ -387,8 +406,9 @@ int sph_cmd_run(int argc, char **argv) {
   }
   if (args.overwrite && !args.resume && root)
     remove_previous(dir, scene->name);
+  sph_halo halo = sph_domain_halo(sim->domain); /* collective */
   if (!args.quiet)
-    banner(whole, dir);
+    banner(whole, dir, &halo);
 
   sph_sink sinks[4];
   int nsinks = 0;

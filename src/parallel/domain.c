@@ -96,11 +96,19 @@ sph_particles *sph_domain_global(const sph_domain *d) {
   return d ? d->all : NULL;
 }
 
-void sph_domain_halo(const sph_domain *d, size_t *doubles, int *messages) {
-  *doubles = d ? d->nsend : 0;
-  *messages = 0;
-  for (int q = 0; d && q < d->size; ++q)
-    *messages += d->send_count[q] > 0;
+sph_halo sph_domain_halo(const sph_domain *d) {
+  sph_halo h = {0.0, 0.0, 0.0, 0.0};
+  if (!d)
+    return h;
+  double v[2] = {(double)d->nsend, 0.0};
+  for (int q = 0; q < d->size; ++q)
+    v[1] += d->send_count[q] > 0;
+  sph_domain_sum(d, v, 2);
+  h.values = v[0];
+  h.messages = v[1];
+  h.max_ghosts = sph_domain_max(d, (double)d->ng);
+  h.max_owned = sph_domain_max(d, (double)d->n);
+  return h;
 }
 
 void sph_domain_destroy(sph_domain *d) {
