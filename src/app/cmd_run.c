@@ -407,6 +407,9 @@ int sph_cmd_run(int argc, char **argv) {
   if (args.overwrite && !args.resume && root)
     remove_previous(dir, scene->name);
   sph_halo halo = sph_domain_halo(sim->domain); /* collective */
+  /* rank 0's whole set has the method's fields before the sinks open */
+  if (st == SPH_OK)
+    st = sph_domain_gather(sim->domain, sim->ps, &err);
   if (!args.quiet)
     banner(whole, dir, &halo);
 
@@ -426,7 +429,8 @@ int sph_cmd_run(int argc, char **argv) {
   }
   sph_verdict *verdict = NULL;
   int index = 0;
-  st = sph_verdict_create(&verdict, root ? whole : sim, &err);
+  if (st == SPH_OK)
+    st = sph_verdict_create(&verdict, root ? whole : sim, &err);
   if (st == SPH_OK && args.resume) {
     char used[1200];
     st = sph_checkpoint_resume(dir, sim, verdict, &index, used, sizeof used,

@@ -5,7 +5,8 @@ reading the files with VTK's own readers (python3-vtk9): the .pvd names a
 PolyData reader) lists RANKS pieces that read without a VTK error or warning
 and together hold the serial particle count and arrays; every value equals
 the serial one (matched by particle_id) within REL_TOL of the array's
-largest magnitude; probes.csv equals the serial file; energy.csv has the
+largest magnitude; the PNG frames (rank 0, from the gathered particles)
+and probes.csv equal the serial files; energy.csv has the
 serial rows, the momenta equal and the energies within REL_TOL (sums over
 ranks in another order). Prints the largest relative difference measured.
 Usage: check_mpi.py SERIAL_DIR MPI_DIR SCENE RANKS REL_TOL"""
@@ -96,6 +97,15 @@ def main():
             if d > tol:
                 fail("%s at t = %g: %s differs from serial by %g (relative)"
                      % (pf, t, name, d))
+    frames = sorted(os.listdir(os.path.join(serial, "frames")))
+    if not frames or frames != sorted(os.listdir(os.path.join(par, "frames"))):
+        fail("frames/ holds %s, serial %s" % (
+            sorted(os.listdir(os.path.join(par, "frames"))), frames))
+    for f in frames:
+        with open(os.path.join(serial, "frames", f), "rb") as a, \
+                open(os.path.join(par, "frames", f), "rb") as b:
+            if a.read() != b.read():
+                fail("frames/%s differs from the serial run's" % f)
     with open(os.path.join(serial, "probes.csv")) as a, \
             open(os.path.join(par, "probes.csv")) as b:
         if a.read() != b.read():

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # sph run over MPI ranks (mpirun, oversubscribed on the machine's cores):
 # the twisting column with tl-csph on 2 and 4 ranks gives the serial run's
-# files (check_mpi.py: fields and probes identical, energies to 1e-12
+# files (check_mpi.py: fields, frames and probes identical, energies to 1e-12
 # relative, the .pvtp series read by VTK with the serial particles and
 # arrays); the same rank count twice writes the same bytes; --overwrite
 # removes a 4-rank run's pieces; what does not run over ranks yet is
@@ -27,7 +27,8 @@ check() { # name, command...
 mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
 [ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
 run=(run twisting_column --quiet --set 'method={name: tl-csph}'
-  --set time.end=0.05 --set output.every=0.01 --set output.png=false
+  --set time.end=0.05 --set output.every=0.01 --set output.png.width=320
+  --set output.png.height=180 --set output.png.mp4=false
   --set 'output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]')
 
 OMP_NUM_THREADS=1 "$sph" "${run[@]}" --out "$work/serial" >/dev/null ||
@@ -42,9 +43,9 @@ done
 # the same rank count and thread count: the same bytes
 check "np 2 again" "${mpi[@]}" -np 2 "$sph" "${run[@]}" --out "$work/np2b"
 same_bytes() {
-  for f in "$work/np2"/*; do
-    b=$(basename "$f")
-    case $b in summary.json | scene_used.yaml) continue ;; esac
+  for f in "$work/np2"/* "$work/np2"/frames/*; do
+    b=${f#"$work/np2/"}
+    case $b in summary.json | scene_used.yaml | frames) continue ;; esac
     cmp -s "$f" "$work/np2b/$b" || { echo "$b differs"; return 1; }
   done
 }
