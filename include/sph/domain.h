@@ -54,7 +54,7 @@ const int64_t *sph_domain_ghost_id(const sph_domain *d);
 typedef struct sph_halo {
   double values, messages, max_ghosts, max_owned;
 } sph_halo;
-sph_halo sph_domain_halo(const sph_domain *d);
+sph_halo sph_domain_halo(sph_domain *d);
 
 /* Sorts each of the first n lists of nl, built over the owned particles
  * followed by the ghosts, by the particles' storage index in the whole set:
@@ -68,15 +68,19 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
 
 /* Global minimum and maximum; sums of count values added in rank order
  * (the same bits for a fixed rank count). */
-double sph_domain_min(const sph_domain *d, double v);
-double sph_domain_max(const sph_domain *d, double v);
-void sph_domain_sum(const sph_domain *d, double *v, int count);
+double sph_domain_min(sph_domain *d, double v);
+double sph_domain_max(sph_domain *d, double v);
+void sph_domain_sum(sph_domain *d, double *v, int count);
 /* Root's value on every rank. */
-int sph_domain_bcast_int(const sph_domain *d, int v);
+int sph_domain_bcast_int(sph_domain *d, int v);
 
 /* Every rank learns whether any failed: the error of the lowest failing
  * rank is returned on all (st itself for NULL). */
-sph_status sph_domain_agree(const sph_domain *d, sph_status st, sph_error *err);
+sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err);
+
+/* Wall seconds this rank spent in halo exchanges, reductions and gathers
+ * (waiting for the other ranks included). */
+double sph_domain_seconds(const sph_domain *d);
 
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
 sph_particles *sph_domain_global(const sph_domain *d);

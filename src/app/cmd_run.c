@@ -465,6 +465,7 @@ int sph_cmd_run(int argc, char **argv) {
   sph_progress prog;
   sph_progress_start(&prog, scene->t_end, args.quiet || !root);
   double wall0 = sph_wtime();
+  double comm0 = sph_domain_seconds(sim->domain);
   int completed = 0;
   if (st == SPH_OK && index == 0)
     st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
@@ -531,6 +532,11 @@ int sph_cmd_run(int argc, char **argv) {
   }
   /* the run's wall time includes waiting for the last frames */
   double wall = sph_wtime() - wall0;
+  /* over MPI ranks: the most a rank spent in exchanges and reductions
+   * (waits included) and outside them (collective) */
+  double comm = sph_domain_seconds(sim->domain) - comm0;
+  double work = sph_domain_max(sim->domain, wall - comm);
+  comm = sph_domain_max(sim->domain, comm);
   /* the animation of the frames, once the run has ended */
   sph_mp4_info mp4 = {0};
   sph_error merr;
@@ -578,6 +584,10 @@ int sph_cmd_run(int argc, char **argv) {
   }
   if (!io_failed && !args.quiet)
     print_sink_times(sinks, nsinks, wall);
+  if (sim->domain && !args.quiet)
+    printf("mpi: %d ranks; exchanges and reductions at most %.2f s of a "
+           "rank's wall (waits included), the rest at most %.2f s\n",
+           sph_domain_size(sim->domain), comm, work);
   if (mp4_tried && mst == SPH_OK)
     printf("mp4: %s (%d frames, %s, %.1f s)\n", mp4.path, mp4.frames, mp4.codec,
            mp4.seconds);

@@ -83,9 +83,11 @@ struct sph_domain {
   int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
   double *gbuf;             /* rank 0: 9 per particle, gathered */
   int *counts, *offs;       /* rank 0: per-gather counts and offsets */
+  double seconds;           /* in exchanges, reductions and gathers */
 };
 
 int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
+double sph_domain_seconds(const sph_domain *d) { return d ? d->seconds : 0.0; }
 int sph_domain_size(const sph_domain *d) { return d ? d->size : 1; }
 size_t sph_domain_ghosts(const sph_domain *d) { return d ? d->ng : 0; }
 const double *sph_domain_ghost_X(const sph_domain *d) { return d->gX; }
@@ -96,7 +98,7 @@ sph_particles *sph_domain_global(const sph_domain *d) {
   return d ? d->all : NULL;
 }
 
-sph_halo sph_domain_halo(const sph_domain *d) {
+sph_halo sph_domain_halo(sph_domain *d) {
   sph_halo h = {0.0, 0.0, 0.0, 0.0};
   if (!d)
     return h;
@@ -390,7 +392,7 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
   }
   /* a halo larger than the domain: more ranks than useful */
   long worst = -1;
-  if (st == SPH_OK && d->ng > d->n)
+  if (st == SPH_OK && (d->ng > d->n || d->n == 0))
     worst = world_rank;
   st = sph_domain_agree(d, st, err);
   long any = -1;
@@ -399,9 +401,9 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
     if (any >= 0)
       st = sph_error_set(err, SPH_ERR_RANGE,
                          "%d ranks are more than useful for %zu particles: "
-                         "rank %ld would hold more ghost particles (one "
-                         "kernel support around its own) than particles it "
-                         "owns; run on fewer ranks",
+                         "rank %ld would own no particle or hold more ghost "
+                         "particles (one kernel support around its own) than "
+                         "particles it owns; run on fewer ranks",
                          world_size, N, any);
   }
   if (st == SPH_OK)
@@ -435,6 +437,7 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
                                sph_error *err) {
   if (!d)
     return SPH_OK;
+  double t0 = MPI_Wtime();
   MPI_Request *req = d->req;
   int nr = 0;
   size_t nc = (size_t)ncomp;
@@ -452,26 +455,31 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
     if (d->send_count[q])
       MPI_Isend(d->buf + nc * (size_t)d->send_off[q], ncomp * d->send_count[q],
                 MPI_DOUBLE, q, 7, MPI_COMM_WORLD, &req[nr++]);
-  if (MPI_Waitall(nr, req, MPI_STATUSES_IGNORE) != MPI_SUCCESS)
+  int rc = MPI_Waitall(nr, req, MPI_STATUSES_IGNORE);
+  d->seconds += MPI_Wtime() - t0;
+  if (rc != MPI_SUCCESS)
     return sph_error_set(err, SPH_ERR_IO, "halo exchange failed");
   return SPH_OK;
 }
 
-double sph_domain_min(const sph_domain *d, double v) {
+double sph_domain_min(sph_domain *d, double v) {
   double out = v;
-  if (d)
-    MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  if (!d)
+    return out;
+  double t0 = MPI_Wtime();
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  d->seconds += MPI_Wtime() - t0;
   return out;
 }
 
-double sph_domain_max(const sph_domain *d, double v) {
+double sph_domain_max(sph_domain *d, double v) {
   double out = v;
   if (d)
     MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   return out;
 }
 
-void sph_domain_sum(const sph_domain *d, double *v, int count) {
+void sph_domain_sum(sph_domain *d, double *v, int count) {
   if (!d || count <= 0 || count > 16)
     return;
   double mine[16], *all = malloc((size_t)d->size * 16 * sizeof *all);
@@ -491,18 +499,19 @@ void sph_domain_sum(const sph_domain *d, double *v, int count) {
   free(all);
 }
 
-int sph_domain_bcast_int(const sph_domain *d, int v) {
+int sph_domain_bcast_int(sph_domain *d, int v) {
   if (d)
     MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
   return v;
 }
 
-sph_status sph_domain_agree(const sph_domain *d, sph_status st,
-                            sph_error *err) {
+sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   if (!d)
     return st;
   int mine = st != SPH_OK ? d->rank : d->size, first = d->size;
+  double t0 = MPI_Wtime();
   MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  d->seconds += MPI_Wtime() - t0;
   if (first == d->size)
     return SPH_OK;
   sph_error e;
@@ -522,6 +531,7 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
     return SPH_OK;
   sph_status st = SPH_OK;
   sph_particles *all = d->all;
+  double t0 = MPI_Wtime();
   for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
     /* the reference positions and volumes never change */
     if (!local->field[f] || f == SPH_FIELD_POSITION0 || f == SPH_FIELD_VOLUME0)
@@ -551,6 +561,7 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
     for (size_t k = 0; k < all->n; ++k)
       all->flags[d->all_gidx[k]] = fl[k];
   }
+  d->seconds += MPI_Wtime() - t0;
   return sph_domain_agree(d, st, err);
 }
 
@@ -569,14 +580,13 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
   return SPH_OK;
 }
 
-double sph_domain_min(const sph_domain *d, double v) { return (void)d, v; }
-double sph_domain_max(const sph_domain *d, double v) { return (void)d, v; }
-void sph_domain_sum(const sph_domain *d, double *v, int count) {
+double sph_domain_min(sph_domain *d, double v) { return (void)d, v; }
+double sph_domain_max(sph_domain *d, double v) { return (void)d, v; }
+void sph_domain_sum(sph_domain *d, double *v, int count) {
   (void)d, (void)v, (void)count;
 }
-int sph_domain_bcast_int(const sph_domain *d, int v) { return (void)d, v; }
-sph_status sph_domain_agree(const sph_domain *d, sph_status st,
-                            sph_error *err) {
+int sph_domain_bcast_int(sph_domain *d, int v) { return (void)d, v; }
+sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   (void)d, (void)err;
   return st;
 }
