@@ -15,21 +15,20 @@ import os
 import sys
 import xml.etree.ElementTree as ET
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "io"))
+from check_vtk import watch  # noqa: E402
+
 
 def fail(msg):
     sys.exit("check_mpi: " + msg)
 
 
 def read(path):
-    from vtkmodules.vtkCommonCore import vtkCommand
     from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPPolyDataReader
-    problems = []
     reader = (vtkXMLPPolyDataReader() if path.endswith(".pvtp")
               else vtkXMLPolyDataReader())
-    for event in (vtkCommand.ErrorEvent, vtkCommand.WarningEvent):
-        reader.AddObserver(event, lambda obj, ev: problems.append(ev))
-        reader.GetExecutive().AddObserver(event,
-                                          lambda obj, ev: problems.append(ev))
+    problems = watch(reader)
     reader.SetFileName(path)
     reader.Update()
     if problems:
