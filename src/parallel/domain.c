@@ -84,6 +84,7 @@ struct sph_domain {
   double *gbuf;             /* rank 0: 9 per particle, gathered */
   int *counts, *offs;       /* rank 0: per-gather counts and offsets */
   double seconds;           /* in exchanges, reductions and gathers */
+  double *sums;             /* 16 per rank: sph_domain_sum's gather */
 };
 
 int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
@@ -135,6 +136,7 @@ void sph_domain_destroy(sph_domain *d) {
   free(d->gbuf);
   free(d->counts);
   free(d->offs);
+  free(d->sums);
   free(d);
 }
 
@@ -350,6 +352,9 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
     d->rank = world_rank;
     d->size = world_size;
     d->dim = all->dim;
+    d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
+    if (!d->sums)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
   }
   if (st == SPH_OK) {
     for (size_t i = 0; i < N; ++i)
@@ -373,15 +378,23 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
       st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
   }
   if (st == SPH_OK) {
-    size_t a = 0, g = d->n;
+    size_t a = 0;
     for (size_t i = 0; i < N; ++i)
       if (owner[i] == world_rank)
         d->gidx[a++] = (int64_t)i;
-    for (int q = 0; q < world_size; ++q)
-      for (size_t i = 0; i < N; ++i)
-        if (ghost[i] && owner[i] == q)
-          d->gidx[g++] = (int64_t)i;
-    for (size_t j = 0; j < d->ng; ++j) {
+    /* ghosts by owner (a counting sort), each owner's in storage order */
+    size_t *at = calloc((size_t)world_size + 1, sizeof *at);
+    if (!at)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
+    for (size_t i = 0; at && i < N; ++i)
+      at[owner[i] + 1] += ghost[i] != 0;
+    for (int q = 0; at && q < world_size; ++q)
+      at[q + 1] += at[q];
+    for (size_t i = 0; at && i < N; ++i)
+      if (ghost[i])
+        d->gidx[d->n + at[owner[i]]++] = (int64_t)i;
+    free(at);
+    for (size_t j = 0; st == SPH_OK && j < d->ng; ++j) {
       size_t i = (size_t)d->gidx[d->n + j];
       memcpy(d->gX + 3 * j, all->field[SPH_FIELD_POSITION0] + 3 * i,
              3 * sizeof *d->gX);
@@ -482,12 +495,8 @@ double sph_domain_max(sph_domain *d, double v) {
 void sph_domain_sum(sph_domain *d, double *v, int count) {
   if (!d || count <= 0 || count > 16)
     return;
-  double mine[16], *all = malloc((size_t)d->size * 16 * sizeof *all);
+  double mine[16], *all = d->sums;
   memcpy(mine, v, (size_t)count * sizeof *v);
-  if (!all) { /* no room for the ordered sum: MPI's own */
-    MPI_Allreduce(mine, v, count, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-    return;
-  }
   MPI_Allgather(mine, count, MPI_DOUBLE, all, count, MPI_DOUBLE,
                 MPI_COMM_WORLD);
   for (int c = 0; c < count; ++c) {
@@ -496,7 +505,6 @@ void sph_domain_sum(sph_domain *d, double *v, int count) {
       s += all[q * count + c];
     v[c] = s;
   }
-  free(all);
 }
 
 int sph_domain_bcast_int(sph_domain *d, int v) {
