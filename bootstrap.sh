@@ -20,6 +20,7 @@ packages=(
   python3-vtk9      # VTK's own reader validates the files we write (tests)
   clang-format      # formatting is a test
   gnuplot-nox       # sph study figures (pngcairo)
+  libopenmpi-dev openmpi-bin  # distributed runs (mpirun -np N sph run)
 )
 for arg in "$@"; do
   case "$arg" in

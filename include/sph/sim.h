@@ -11,6 +11,7 @@
 
 #include <stddef.h>
 
+#include "sph/domain.h"
 #include "sph/kernel.h"
 #include "sph/neighbors.h"
 #include "sph/node.h"
@@ -42,6 +43,7 @@ typedef struct sph_stage {
 typedef struct sph_term_ops {
   const char *name;      /* as printed and in summary.json */
   const char *reference; /* seed and equations */
+  int distributed;       /* runs over MPI ranks on owned particles */
   /* adds its contribution to the stage rates (may be NULL) */
   sph_status (*rates)(sph_term *term, sph_sim *sim, sph_stage *stage,
                       sph_error *err);
@@ -74,7 +76,8 @@ typedef struct sph_method_ops {
   const char *title;              /* readable name */
   const char *reference;          /* seed sections and equations */
   int conserves_angular_momentum; /* to round-off, for a free body */
-  unsigned long fields;           /* the output fields it fills: bit 1ul << f */
+  int distributed;      /* runs over MPI ranks (sph_domain: owned + ghosts) */
+  unsigned long fields; /* the output fields it fills: bit 1ul << f */
   /* validates the method block, requires fields, creates its terms */
   sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);
   double (*stable_dt)(sph_sim *sim);
@@ -123,6 +126,7 @@ struct sph_sim {
   const sph_mirror *mirror;        /* NULL without symmetry planes */
   struct sph_reference *reference; /* the scene's reference, or NULL */
   int initial_defgrad;             /* DEFGRAD holds the initial F (reference) */
+  sph_domain *domain; /* this rank's share of a distributed run, or NULL */
 };
 
 /* Method table lookup (the registry lists every method once). */

@@ -47,6 +47,18 @@ static int run_file(const char *name, const char *scene, const char *suffix,
   return !strcmp(rest, suffix);
 }
 
+/* name is a VTK piece of a run over MPI ranks, <scene>_NNNN_pR.vtp[.part] */
+static int piece_file(const char *name, const char *scene) {
+  size_t p = strlen(scene);
+  if (strncmp(name, scene, p) || name[p] != '_' ||
+      strspn(name + p + 1, "0123456789") != 4 || strncmp(name + p + 5, "_p", 2))
+    return 0;
+  const char *rest = name + p + 7;
+  size_t digits = strspn(rest, "0123456789");
+  return digits > 0 && (!strcmp(rest + digits, ".vtp") ||
+                        !strcmp(rest + digits, ".vtp.part"));
+}
+
 /* Removes the files in dir that the run named `scene` writes, and its
  * temporary (.part) ones. */
 static void remove_run_files(const char *dir, const char *scene) {
@@ -57,8 +69,8 @@ static void remove_run_files(const char *dir, const char *scene) {
                                       SPH_CHECKPOINT_FILE,
                                       SPH_CHECKPOINT_PREVIOUS,
                                       NULL};
-  static const char *const numbered[] = {".vtp", ".vtp.part", ".png",
-                                         ".png.part", NULL};
+  static const char *const numbered[] = {
+      ".vtp", ".vtp.part", ".pvtp", ".pvtp.part", ".png", ".png.part", NULL};
   static const char *const single[] = {".pvd", ".pvd.part", ".mp4", ".mp4.part",
                                        NULL};
   char path[2400];
@@ -79,6 +91,7 @@ static void remove_run_files(const char *dir, const char *scene) {
         ours = run_file(e->d_name, scene, *x, 1);
       for (const char *const *x = single; *x && !ours && k == 0; ++x)
         ours = run_file(e->d_name, scene, *x, 0);
+      ours = ours || (k == 0 && piece_file(e->d_name, scene));
       if (!ours)
         continue;
       snprintf(path, sizeof path, "%s/%s", sub[k], e->d_name);
@@ -109,7 +122,7 @@ static void remove_previous(const char *dir, const char *scene) {
   remove_run_files(dir, scene);
 }
 
-static void banner(const sph_sim *sim, const char *dir) {
+static void banner(const sph_sim *sim, const char *dir, const sph_halo *h) {
   const sph_scene *s = sim->scene;
   printf("sph: %s (%s)\n", s->name, s->path);
   printf("  method     %s: %s\n             [%s]\n", sim->method->name,
@@ -124,6 +137,12 @@ static void banner(const sph_sim *sim, const char *dir) {
     printf(" %s", sim->terms[i].ops->name);
   printf("\n  time       0 .. %.6g s, output every %.6g s, %d thread%s\n",
          s->t_end, s->output.every, sim->threads, sim->threads == 1 ? "" : "s");
+  if (sim->domain)
+    printf("  ranks      %d (MPI, recursive coordinate bisection): at most "
+           "%.0f owned and %.0f ghost particles a rank; halo %.0f particles "
+           "in %.0f messages per exchange\n",
+           sph_domain_size(sim->domain), h->max_owned, h->max_ghosts, h->values,
+           h->messages);
   printf("  output     %s/\n", dir);
   fflush(stdout);
 }
@@ -163,11 +182,20 @@ static void print_sink_times(const sph_sink *sinks, int nsinks, double wall) {
   printf(" of %.2f s wall\n", wall);
 }
 
-/* derive, then every sink and the verdict see the same frame */
-static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
-                               sph_verdict *v, int index, sph_error *err) {
+/* Over MPI ranks every rank writes its VTK piece; the other sinks run on
+ * rank 0 only. */
+static int piece_sink(const sph_sim *sim, const sph_sink *sink) {
+  return sim->domain && sink->ops == &sph_vtk_sink_ops;
+}
+
+/* derive, then every sink and the verdict see the same frame; over MPI
+ * ranks the energies are summed over them and the fields gathered to rank
+ * 0, where `view` is the run seen whole (rank 0's sinks and verdict) */
+static sph_status output_frame(sph_sim *sim, sph_sim *view, sph_sink *sinks,
+                               int nsinks, sph_verdict *v, int index,
+                               sph_error *err) {
   sph_status st = sim->method->derive(sim, err);
-  if (st != SPH_OK)
+  if ((st = sph_domain_agree(sim->domain, st, err)) != SPH_OK)
     return st;
   sph_frame fr = {.time = sim->t,
                   .step = sim->steps,
@@ -175,15 +203,37 @@ static sph_status output_frame(sph_sim *sim, sph_sink *sinks, int nsinks,
                   .sim = sim,
                   .ps = sim->ps};
   sim->method->energy(sim, &fr.kinetic, &fr.strain);
-  for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+  sph_frame whole = fr;
+  int root = sph_domain_rank(sim->domain) == 0;
+  if (sim->domain) {
+    double e[2] = {fr.kinetic, fr.strain};
+    sph_domain_sum(sim->domain, e, 2);
+    fr.kinetic = whole.kinetic = e[0];
+    fr.strain = whole.strain = e[1];
+    SPH_TRY(sph_domain_gather(sim->domain, sim->ps, err));
+    if (root) {
+      sph_particles *all = view->ps;
+      *view = *sim;
+      view->ps = all;
+      whole.sim = view;
+      whole.ps = all;
+    }
+  }
+  for (int i = 0; i < nsinks; ++i) {
+    int piece = piece_sink(sim, &sinks[i]);
+    if ((st != SPH_OK && !piece) || (!root && !piece))
+      continue; /* pieces are collective: every rank writes its own */
     double t0 = sph_wtime();
-    st = sinks[i].ops->write(&sinks[i], &fr, err);
+    sph_status sst = sinks[i].ops->write(&sinks[i], piece ? &fr : &whole, err);
+    st = st == SPH_OK ? sst : st;
     sinks[i].seconds += sph_wtime() - t0;
   }
-  if (st == SPH_OK)
-    st = sph_verdict_observe(v, &fr, err);
+  if (st == SPH_OK && root)
+    st = sph_verdict_observe(v, &whole, err);
   if (st == SPH_OK && sim->reference)
     sph_reference_observe(sim->reference, &fr);
+  st = sph_domain_agree(sim->domain, st, err);
+  v->stable = sph_domain_bcast_int(sim->domain, v->stable);
   return st;
 }
 
@@ -267,6 +317,10 @@ int sph_cmd_run(int argc, char **argv) {
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   const char *path = args.scene ? args.scene : sph_app_default_scene();
+  /* over MPI ranks rank 0 prints for all */
+  int root = sph_domain_world_rank() == 0;
+  if (!root && !freopen("/dev/null", "w", stdout))
+    return SPH_EXIT_IO;
   sph_scene *scene;
   sph_sim *sim;
   if ((rc = sph_app_load(&args, path, &scene, &sim)) != SPH_EXIT_OK)
@@ -275,6 +329,19 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error_clear(&err);
   sph_status st = SPH_OK;
   char dir[1024];
+  /* rank 0's view of a distributed run: every particle, gathered */
+  sph_sim view = *sim;
+  if (sim->domain && root)
+    view.ps = sph_domain_global(sim->domain);
+  const sph_sim *whole = sim->domain ? &view : sim;
+  if (args.resume && sim->domain) {
+    if (root)
+      fprintf(stderr, "sph: --resume does not run over MPI ranks yet; "
+                      "resume without mpirun\n");
+    sph_sim_destroy(sim);
+    sph_scene_destroy(scene);
+    return SPH_EXIT_USAGE;
+  }
   if (args.resume && args.out && strcmp(args.resume, args.out)) {
     fprintf(stderr, "sph: --resume continues in its own folder; drop --out "
                     "or give the same folder\n");
@@ -302,12 +369,14 @@ int sph_cmd_run(int argc, char **argv) {
   long holder = 0;
   int lock_fd = -1;
   struct stat rst;
-  if (args.resume && stat(dir, &rst) != 0) /* not made for a resume */
+  if (!root)
+    ; /* rank 0 makes, locks and checks the folder for every rank */
+  else if (args.resume && stat(dir, &rst) != 0) /* not made for a resume */
     st = sph_error_set(&err, SPH_ERR_ARG, "nothing to resume in %s: %s", dir,
                        strerror(errno));
   else
     st = sph_app_output_dir(dir, &err);
-  if (st == SPH_OK && (lock_fd = lock_output(dir, &holder)) < 0) {
+  if (st == SPH_OK && root && (lock_fd = lock_output(dir, &holder)) < 0) {
     if (holder > 0)
       st = sph_error_set(&err, SPH_ERR_ARG,
                          "%s is in use by another sph run (pid %ld); wait for "
@@ -319,13 +388,14 @@ int sph_cmd_run(int argc, char **argv) {
                          strerror(errno));
   }
   /* after the lock: a folder in use says so, whatever it holds */
-  if (st == SPH_OK && !args.overwrite && !args.resume &&
+  if (st == SPH_OK && root && !args.overwrite && !args.resume &&
       (file_exists(dir, "summary.json") || file_exists(dir, "scene_used.yaml")))
     st = sph_error_set(&err, SPH_ERR_ARG,
                        "%s holds the results of an earlier run; pass "
                        "--overwrite to replace them or --out DIR to write "
                        "elsewhere",
                        dir);
+  st = sph_domain_agree(sim->domain, st, &err);
   if (st != SPH_OK) {
     sph_app_print_error(&err);
     if (lock_fd >= 0)
@@ -334,10 +404,14 @@ int sph_cmd_run(int argc, char **argv) {
     sph_scene_destroy(scene);
     return SPH_EXIT_USAGE;
   }
-  if (args.overwrite && !args.resume)
+  if (args.overwrite && !args.resume && root)
     remove_previous(dir, scene->name);
+  sph_halo halo = sph_domain_halo(sim->domain); /* collective */
+  /* rank 0's whole set has the method's fields before the sinks open */
+  if (st == SPH_OK)
+    st = sph_domain_gather(sim->domain, sim->ps, &err);
   if (!args.quiet)
-    banner(sim, dir);
+    banner(whole, dir, &halo);
 
   sph_sink sinks[4];
   int nsinks = 0;
@@ -355,7 +429,8 @@ int sph_cmd_run(int argc, char **argv) {
   }
   sph_verdict *verdict = NULL;
   int index = 0;
-  st = sph_verdict_create(&verdict, sim, &err);
+  if (st == SPH_OK)
+    st = sph_verdict_create(&verdict, root ? whole : sim, &err);
   if (st == SPH_OK && args.resume) {
     char used[1200];
     st = sph_checkpoint_resume(dir, sim, verdict, &index, used, sizeof used,
@@ -371,22 +446,29 @@ int sph_cmd_run(int argc, char **argv) {
       printf("  resume     %s: t = %.6g s, step %lu, next output %d\n", used,
              sim->t, sim->steps, index);
   }
-  if (st == SPH_OK)
+  if (st == SPH_OK && root)
     st = write_scene_used(scene, dir, &err);
   for (int i = 0; i < nsinks && st == SPH_OK; ++i) {
+    int piece = piece_sink(sim, &sinks[i]);
+    if (!root && !piece)
+      continue;
     double t0 = sph_wtime();
     sinks[i].resume_frames = index;
-    st = sinks[i].ops->open(&sinks[i], sim, dir, &err);
+    st = sinks[i].ops->open(&sinks[i], piece ? sim : whole, dir, &err);
     sinks[i].seconds += sph_wtime() - t0;
   }
+  st = sph_domain_agree(sim->domain, st, &err);
 
-  catch_stop_signals();
+  /* over MPI ranks a signal ends every rank at once (no checkpoints yet) */
+  if (!sim->domain)
+    catch_stop_signals();
   sph_progress prog;
-  sph_progress_start(&prog, scene->t_end, args.quiet);
+  sph_progress_start(&prog, scene->t_end, args.quiet || !root);
   double wall0 = sph_wtime();
+  double comm0 = sph_domain_seconds(sim->domain);
   int completed = 0;
   if (st == SPH_OK && index == 0)
-    st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
+    st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
   double t_end = scene->t_end, ckpt = scene->output.checkpoint_every;
   double eps = 1e-12 * t_end;
   double next_ckpt =
@@ -400,7 +482,7 @@ int sph_cmd_run(int argc, char **argv) {
     sph_progress_step(&prog, sim->t, sim->steps);
     if (sim->t >= next - eps) {
       sim->t = next; /* land exactly on the output time */
-      st = output_frame(sim, sinks, nsinks, verdict, index++, &err);
+      st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
       sph_progress_output(&prog, sim->t, sim->steps);
     }
     if (st == SPH_OK && sim->t >= next_ckpt - eps && sim->t < t_end - eps) {
@@ -450,21 +532,29 @@ int sph_cmd_run(int argc, char **argv) {
   }
   /* the run's wall time includes waiting for the last frames */
   double wall = sph_wtime() - wall0;
+  /* over MPI ranks: the most a rank spent in exchanges and reductions
+   * (waits included) and outside them (collective) */
+  double comm = sph_domain_seconds(sim->domain) - comm0;
+  double work = sph_domain_max(sim->domain, wall - comm);
+  comm = sph_domain_max(sim->domain, comm);
   /* the animation of the frames, once the run has ended */
   sph_mp4_info mp4 = {0};
   sph_error merr;
   sph_status mst = SPH_OK;
   int mp4_tried = scene->output.png.enabled && scene->output.png.mp4 &&
-                  !io_failed && index > 0;
+                  !io_failed && index > 0 && root;
   if (mp4_tried)
     mst = sph_mp4_assemble(dir, scene->name, index, scene->output.png.fps, &mp4,
                            &merr);
-  if (verdict && !io_failed) {
+  if (verdict && !io_failed && root) {
     char spath[1200];
     snprintf(spath, sizeof spath, "%s/summary.json", dir);
     sph_provenance prov;
     sph_app_provenance(&prov);
-    if (sph_summary_write(spath, sim, &prov, verdict, wall, sinks, nsinks,
+    sph_particles *all = view.ps;
+    view = *sim; /* the counts and timers of the end of the run */
+    view.ps = all;
+    if (sph_summary_write(spath, whole, &prov, verdict, wall, sinks, nsinks,
                           mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
                           completed, stopped ? signal_name(stopped) : NULL,
                           &cerr) != SPH_OK) {
@@ -489,11 +579,15 @@ int sph_cmd_run(int argc, char **argv) {
   } else {
     printf("verdict: stable (%lu steps, %.2f s wall, %.3g particle-steps/s)\n",
            sim->steps, wall,
-           wall > 0 ? (double)sim->steps * (double)sim->ps->n / wall : 0.0);
+           wall > 0 ? (double)sim->steps * (double)whole->ps->n / wall : 0.0);
     rc = SPH_EXIT_OK;
   }
   if (!io_failed && !args.quiet)
     print_sink_times(sinks, nsinks, wall);
+  if (sim->domain && !args.quiet)
+    printf("mpi: %d ranks; exchanges and reductions at most %.2f s of a "
+           "rank's wall (waits included), the rest at most %.2f s\n",
+           sph_domain_size(sim->domain), comm, work);
   if (mp4_tried && mst == SPH_OK)
     printf("mp4: %s (%d frames, %s, %.1f s)\n", mp4.path, mp4.frames, mp4.codec,
            mp4.seconds);
@@ -504,9 +598,11 @@ int sph_cmd_run(int argc, char **argv) {
     sph_error_format(&merr, msg, sizeof msg);
     fprintf(stderr, "sph: warning: no mp4: %s\n", msg);
   }
+  rc = sph_domain_bcast_int(sim->domain, rc); /* rank 0's verdict */
   sph_verdict_destroy(verdict);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
-  close(lock_fd); /* the folder is free for the next run */
+  if (lock_fd >= 0)
+    close(lock_fd); /* the folder is free for the next run */
   return rc;
 }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "app/app_impl.h"
+#include "sph/domain.h"
 #include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
@@ -154,6 +155,8 @@ int sph_app_exit_code(sph_status st) {
 }
 
 void sph_app_print_error(const sph_error *err) {
+  if (sph_domain_world_rank() != 0) /* over MPI: rank 0 speaks for all */
+    return;
   char buf[2048];
   sph_error_format(err, buf, sizeof buf);
   fprintf(stderr, "sph: %s\n", buf);
@@ -287,11 +290,37 @@ static void short_spin_wait_policy(char **argv) {
   /* not re-executed: the run goes on with libgomp's default policy */
 }
 
+static int dispatch(int argc, char **argv);
+
+/* Under mpirun MPI is started here and ended after the command; only run
+ * works over several ranks. */
 int main(int argc, char **argv) {
   /* past a file-size limit a write fails with EFBIG, reported like a full
    * disk, instead of the process being killed mid-file */
   signal(SIGXFSZ, SIG_IGN);
-  short_spin_wait_policy(argv);
+  short_spin_wait_policy(argv); /* before MPI: it may start sph again */
+  sph_error err;
+  sph_error_clear(&err);
+  if (sph_domain_init(&argc, &argv, &err) != SPH_OK) {
+    sph_app_print_error(&err);
+    return SPH_EXIT_USAGE;
+  }
+  int rc;
+  if (sph_domain_world_size() > 1 && (argc < 2 || strcmp(argv[1], "run"))) {
+    if (sph_domain_world_rank() == 0)
+      fprintf(stderr,
+              "sph: only 'sph run' works over MPI ranks (started "
+              "with %d); run other commands without mpirun\n",
+              sph_domain_world_size());
+    rc = SPH_EXIT_USAGE;
+  } else {
+    rc = dispatch(argc, argv);
+  }
+  sph_domain_finalize();
+  return rc;
+}
+
+static int dispatch(int argc, char **argv) {
   remember_command_line(argc, argv);
   if (argc < 2) {
     usage(stdout);

@@ -97,6 +97,8 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_number(f, thread_seconds);
   fprintf(f, ",\n  \"particles\": %zu,\n  \"steps\": %lu,\n", sim->ps->n,
           sim->steps);
+  if (sim->domain) /* a run over MPI ranks; the timers are rank 0's */
+    fprintf(f, "  \"ranks\": %d,\n", sph_domain_size(sim->domain));
   fputs("  \"wall_seconds\": ", f);
   json_number(f, wall_seconds);
   fputs(",\n  \"dt_min\": ", f);

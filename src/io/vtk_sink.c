@@ -10,20 +10,25 @@
  * each appended array is one zlib block behind VTK's compression header
  * (vtkZLibDataCompressor, UInt64 words: 1 block, its size, 0, the
  * compressed size); the blocks are compressed first, since the XML header
- * gives their offsets. */
+ * gives their offsets. Over MPI ranks (sph_domain) each rank writes its
+ * owned particles as a piece <scene>_NNNN_pR.vtp and rank 0, once every
+ * piece is in place, the <scene>_NNNN.pvtp that lists them (VTK's
+ * parallel PolyData), which the .pvd names. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zlib.h>
 
+#include "sph/domain.h"
 #include "sph/sink.h"
 
 typedef struct vtk_sink {
   char dir[1024];
   char name[64];
   int ascii;
-  double *times; /* of the files written so far */
+  int rank, ranks; /* this process's piece and the pieces of a frame */
+  double *times;   /* of the files written so far */
   int nframes, cap;
   int64_t *ids; /* connectivity / offsets work array */
   size_t n;
@@ -64,6 +69,8 @@ static sph_status vtk_open(sph_sink *sink, const sph_sim *sim, const char *dir,
   snprintf(v->dir, sizeof v->dir, "%s", dir);
   snprintf(v->name, sizeof v->name, "%s", sim->scene->name);
   v->ascii = sim->scene->output.vtk_ascii;
+  v->rank = sph_domain_rank(sim->domain);
+  v->ranks = sph_domain_size(sim->domain);
   v->n = sim->ps->n;
   v->cap = (int)(sim->scene->t_end / sim->scene->output.every) + 4;
   v->times = malloc((size_t)v->cap * sizeof *v->times);
@@ -206,8 +213,8 @@ static sph_status write_pvd(vtk_sink *v, sph_error *err) {
   for (int i = 0; i < v->nframes; ++i)
     fprintf(af.f,
             "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" "
-            "file=\"%s_%04d.vtp\"/>\n",
-            v->times[i], v->name, i);
+            "file=\"%s_%04d.%s\"/>\n",
+            v->times[i], v->name, i, v->ranks > 1 ? "pvtp" : "vtp");
   fputs("  </Collection>\n</VTKFile>\n", af.f);
   sph_status st = sph_atomic_commit(&af, err);
   if (st != SPH_OK)
@@ -215,14 +222,43 @@ static sph_status write_pvd(vtk_sink *v, sph_error *err) {
   return st;
 }
 
-static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
-                            sph_error *err) {
-  vtk_sink *v = sink->data;
-  size_t n = fr->ps->n;
-  if (fr->index >= 10000)
-    return sph_error_set(err, SPH_ERR_ARG, "more than 9999 VTK frames");
+/* the .pvtp of a distributed frame: the arrays of the pieces, their files */
+static sph_status write_pvtp(const vtk_sink *v, const sph_frame *fr,
+                             sph_error *err) {
   char path[1200];
-  snprintf(path, sizeof path, "%s/%s_%04d.vtp", v->dir, v->name, fr->index);
+  snprintf(path, sizeof path, "%s/%s_%04d.pvtp", v->dir, v->name, fr->index);
+  array_desc arrays[SPH_FIELD_COUNT + 2];
+  int na = frame_arrays(fr, arrays, SPH_FIELD_COUNT + 2);
+  sph_atomic_file af;
+  SPH_TRY(sph_atomic_open(&af, path, err));
+  fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"PPolyData\" "
+        "version=\"1.0\" byte_order=\"LittleEndian\" "
+        "header_type=\"UInt64\">\n  <PPolyData GhostLevel=\"0\">\n"
+        "    <PPointData>\n",
+        af.f);
+  for (int i = 0; i < na; ++i)
+    fprintf(af.f,
+            "      <PDataArray type=\"%s\" Name=\"%s\" "
+            "NumberOfComponents=\"%d\"/>\n",
+            arrays[i].type, arrays[i].name, arrays[i].ncomp);
+  fputs("    </PPointData>\n    <PPoints>\n      <PDataArray "
+        "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+        "    </PPoints>\n",
+        af.f);
+  for (int r = 0; r < v->ranks; ++r)
+    fprintf(af.f, "    <Piece Source=\"%s_%04d_p%d.vtp\"/>\n", v->name,
+            fr->index, r);
+  fputs("  </PPolyData>\n</VTKFile>\n", af.f);
+  sph_status st = sph_atomic_commit(&af, err);
+  if (st != SPH_OK)
+    sph_atomic_abort(&af);
+  return st;
+}
+
+/* the .vtp of a frame (a piece of it over MPI ranks) */
+static sph_status write_vtp(vtk_sink *v, const sph_frame *fr, const char *path,
+                            sph_error *err) {
+  size_t n = fr->ps->n;
   array_desc arrays[SPH_FIELD_COUNT + 2];
   int na = frame_arrays(fr, arrays, SPH_FIELD_COUNT + 2);
   const double *x = fr->ps->field[SPH_FIELD_POSITION]
@@ -304,10 +340,31 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
   }
   fputs("</VTKFile>\n", f);
   sph_status st = sph_atomic_commit(&af, err);
-  if (st != SPH_OK) {
+  if (st != SPH_OK)
     sph_atomic_abort(&af);
-    return st;
+  return st;
+}
+
+static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
+                            sph_error *err) {
+  vtk_sink *v = sink->data;
+  if (fr->index >= 10000)
+    return sph_error_set(err, SPH_ERR_ARG, "more than 9999 VTK frames");
+  char path[1200];
+  if (v->ranks > 1)
+    snprintf(path, sizeof path, "%s/%s_%04d_p%d.vtp", v->dir, v->name,
+             fr->index, v->rank);
+  else
+    snprintf(path, sizeof path, "%s/%s_%04d.vtp", v->dir, v->name, fr->index);
+  sph_status st = write_vtp(v, fr, path, err);
+  /* every piece in place before the .pvtp names them */
+  if (v->ranks > 1) {
+    st = sph_domain_agree(fr->sim->domain, st, err);
+    if (st == SPH_OK && v->rank == 0)
+      st = write_pvtp(v, fr, err);
   }
+  if (st != SPH_OK)
+    return st;
   if (v->nframes == v->cap) {
     double *t = realloc(v->times, 2 * (size_t)v->cap * sizeof *t);
     if (!t)
@@ -316,7 +373,7 @@ static sph_status vtk_write(sph_sink *sink, const sph_frame *fr,
     v->cap *= 2;
   }
   v->times[v->nframes++] = fr->time;
-  return write_pvd(v, err);
+  return v->rank == 0 ? write_pvd(v, err) : SPH_OK;
 }
 
 static sph_status vtk_close(sph_sink *sink, sph_error *err) { return SPH_OK; }

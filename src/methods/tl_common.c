@@ -224,8 +224,20 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     if (st != SPH_OK)
       return st;
   }
+  /* other ranks' particles within a support of ours */
+  size_t ng = sph_domain_ghosts(sim->domain);
+  SPH_TRY(grow_points(r, total + ng, &cap, oblique, err));
+  for (size_t g = 0; g < ng; ++g) {
+    size_t i = total + g;
+    memcpy(r->X + 3 * i, sph_domain_ghost_X(sim->domain) + 3 * g,
+           3 * sizeof *r->X);
+    r->V[i] = sph_domain_ghost_volume(sim->domain)[g];
+    r->body[i] = sph_domain_ghost_body(sim->domain)[g];
+    r->src[i] = -1;
+  }
   r->n = n;
-  r->n_ext = total;
+  r->n_img = total;
+  r->n_ext = total + ng;
   r->mirror = (sph_mirror){.n_real = n,
                            .n_ghost = total - n,
                            .src = r->src + n,
@@ -339,6 +351,8 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
   SPH_TRY(sph_neighbors_build(ref->nl, ref->X, ne, s->dimension,
                               sim->kernel.support, ref->body,
                               SPH_PAIRS_SAME_BODY, err));
+  /* a distributed run sums pairs in the serial run's order */
+  sph_domain_sort_lists(sim->domain, ref->nl, ref->n_img);
   if (ref->nl->count + 1 > ref->w_cap) { /* grows only, amortised */
     size_t cap = 2 * (ref->nl->count + 1);
     double *w = realloc(ref->w, cap * sizeof *w);
@@ -347,7 +361,8 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
     ref->w = w;
     ref->w_cap = cap;
   }
-  sph_cloud cloud = {.n = ne,
+  /* ghosts lack part of their neighbourhood: their L comes from the owner */
+  sph_cloud cloud = {.n = sim->domain ? ref->n_img : ne,
                      .dim = s->dimension,
                      .x = ref->X,
                      .volume = ref->V,
@@ -356,6 +371,7 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
                      .kernel = &sim->kernel};
   SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL,
                                   ref->L, err));
+  SPH_TRY(sph_domain_exchange(sim->domain, ref->L, 9, err));
   pair_weights(ref, &sim->kernel);
   return SPH_OK;
 }
@@ -369,7 +385,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   double t0 = sph_wtime();
   SPH_TRY(build_images(ref, sim, images, err));
   size_t n = ref->n, ne = ref->n_ext;
-  if (ne > n)
+  if (ref->n_img > n)
     sim->mirror = &ref->mirror;
 
   /* per-point material and density, the fastest wave */
@@ -443,7 +459,8 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   if (!id)
     return sph_error_set(err, SPH_ERR_NOMEM, "ids");
   for (size_t a = 0; a < ne; ++a)
-    id[a] = ps->id[ref->src[a]];
+    id[a] = a < ref->n_img ? ps->id[ref->src[a]]
+                           : sph_domain_ghost_id(sim->domain)[a - ref->n_img];
   ref->id = id;
   ref->s = calloc(3 * n + 3, sizeof *ref->s);
   if (!ref->s)
@@ -514,7 +531,7 @@ static inline void mirror_tensor_oblique(const double *A, double *out,
 
 static void mirror_refresh_oblique(const tl_reference *ref, double *x,
                                    double *p, double *F, double *H, double *J) {
-  long n = (long)ref->n, ne = (long)ref->n_ext;
+  long n = (long)ref->n, ne = (long)ref->n_img;
 #pragma omp parallel for schedule(static)
   for (long g = n; g < ne; ++g) {
     size_t s = (size_t)ref->src[g];
@@ -543,7 +560,7 @@ void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
     mirror_refresh_oblique(ref, x, p, F, H, J);
     return;
   }
-  long n = (long)ref->n, ne = (long)ref->n_ext;
+  long n = (long)ref->n, ne = (long)ref->n_img;
 #pragma omp parallel for schedule(static)
   for (long g = n; g < ne; ++g) {
     size_t s = (size_t)ref->src[g];

@@ -28,16 +28,18 @@
    1ul << SPH_FIELD_DISPLACEMENT)
 
 typedef struct tl_reference {
-  size_t n, n_ext;          /* real particles, real + mirror images */
-  double *X;                /* reference positions (3 n_ext) */
-  double *V;                /* volumes (n_ext) */
-  int32_t *body;            /* bodies (n_ext) */
-  sph_neighbors *nl;        /* over all n_ext points, same body only */
-  double *w;                /* V_b W'(r_ab) / r_ab per slot */
-  size_t w_cap;             /* slots w holds */
-  int64_t *id;              /* particle id per point (n_ext) */
-  double *L;                /* correction matrix per point (9 n_ext) */
-  double *s;                /* sum_b w_ab r_ab per particle (3 n) */
+  size_t n, n_ext;   /* real particles, real + mirror images + ghosts */
+  size_t n_img;      /* real + mirror images; the ghosts of a distributed run
+                        (sph_domain) follow, their state set by exchange */
+  double *X;         /* reference positions (3 n_ext) */
+  double *V;         /* volumes (n_ext) */
+  int32_t *body;     /* bodies (n_ext) */
+  sph_neighbors *nl; /* over all n_ext points, same body only */
+  double *w;         /* V_b W'(r_ab) / r_ab per slot */
+  size_t w_cap;      /* slots w holds */
+  int64_t *id;       /* particle id per point (n_ext) */
+  double *L;         /* correction matrix per point (9 n_ext) */
+  double *s;         /* sum_b w_ab r_ab per particle (3 n) */
   const sph_material **mat; /* per point (n_ext) */
   double *rho0;             /* per point (n_ext) */
   double cp;                /* largest p-wave speed of the materials */

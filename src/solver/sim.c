@@ -117,6 +117,51 @@ static sph_status check_memory(const sph_scene *scene, double support,
       n, need / 1e9, avail / 1e9);
 }
 
+/* A distributed run (more than one MPI rank) of what runs distributed so
+ * far: refused, the same on every rank, before anything is written. */
+static sph_status distribute(sph_sim *sim, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_node *out = sph_node_child(s->root, "output");
+  const sph_node *bcs = sph_node_child(s->root, "boundaries");
+  if (!sim->method->distributed) {
+    const sph_node *name = sph_node_child(s->method, "name");
+    return sph_node_error(name ? name : s->method, err, SPH_ERR_UNSUPPORTED,
+                          "%s does not run over MPI ranks yet (tl-csph "
+                          "does); run it without mpirun",
+                          sim->method->name);
+  }
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY)
+      return sph_node_error(bcs && k < bcs->count ? bcs->items[k] : s->root,
+                            err, SPH_ERR_UNSUPPORTED,
+                            "symmetry planes (mirror images) do not run over "
+                            "MPI ranks yet; run without mpirun");
+  if (sim->reference)
+    return sph_node_error(s->root, err, SPH_ERR_UNSUPPORTED,
+                          "a scene reference (initial state) does not run "
+                          "over MPI ranks yet; run without mpirun");
+  if (s->output.checkpoint_every > 0.0) {
+    const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;
+    return sph_node_error(ck ? ck : s->root, err, SPH_ERR_UNSUPPORTED,
+                          "checkpoints are not written over MPI ranks yet; "
+                          "drop output.checkpoint_every or run without "
+                          "mpirun");
+  }
+  return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
+}
+
+/* Every term a distributed method creates must run on owned particles. */
+static sph_status check_distributed_terms(const sph_sim *sim, sph_error *err) {
+  for (int i = 0; sim->domain && i < sim->nterms; ++i)
+    if (!sim->terms[i].ops->distributed)
+      return sph_node_error(sim->scene->method, err, SPH_ERR_UNSUPPORTED,
+                            "the term %s does not run over MPI ranks yet; "
+                            "run without mpirun",
+                            sim->terms[i].ops->name);
+  return SPH_OK;
+}
+
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err) {
   *out = NULL;
@@ -162,10 +207,15 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
     st = sph_particles_sort_morton(sim->ps, sim->kernel.support, err);
   if (st == SPH_OK)
     st = sph_reference_create(&sim->reference, scene, err);
+  /* over MPI ranks: this rank's owned particles from here on */
+  if (st == SPH_OK && sph_domain_world_size() > 1)
+    st = distribute(sim, err);
   if (st == SPH_OK && sim->reference)
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)
     st = method->setup(sim, scene->method, err);
+  if (st == SPH_OK)
+    st = check_distributed_terms(sim, err);
   if (st == SPH_OK)
     st = check_output_fields(sim, err);
   /* the time step rule (a wave speed per particle) is work of every step */
@@ -189,6 +239,7 @@ void sph_sim_destroy(sph_sim *sim) {
     sim->method->destroy(sim);
   sph_particles_destroy(sim->ps);
   sph_reference_destroy(sim->reference);
+  sph_domain_destroy(sim->domain);
   free(sim);
 }
 
@@ -197,7 +248,8 @@ double sph_sim_stable_dt(sph_sim *sim) {
   for (int i = 0; i < sim->nterms; ++i)
     if (sim->terms[i].ops->stable_dt)
       dt = fmin(dt, sim->terms[i].ops->stable_dt(&sim->terms[i], sim));
-  return dt;
+  /* the smallest over the ranks (exact: the serial run's step) */
+  return sph_domain_min(sim->domain, dt);
 }
 
 sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
@@ -220,6 +272,7 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
   if (dt > dt_cap)
     dt = dt_cap;
   sph_status st = sim->method->step(sim, dt, err);
+  st = sph_domain_agree(sim->domain, st, err);
   if (st != SPH_OK)
     return st;
   sim->t += dt;

@@ -25,6 +25,7 @@ static void body_force_destroy(sph_term *term) { free(term->data); }
 static const sph_term_ops body_force_ops = {
     .name = "body_force",
     .reference = "seed 000 eq. 27c",
+    .distributed = 1,
     .rates = body_force_rates,
     .destroy = body_force_destroy,
 };

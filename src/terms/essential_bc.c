@@ -99,6 +99,7 @@ static void bc_destroy(sph_term *term) {
 static const sph_term_ops essential_bc_ops = {
     .name = "essential_bc",
     .reference = "seed 000 Algorithm 1 step 8",
+    .distributed = 1,
     .rates = bc_rates,
     .constrain = bc_constrain,
     .destroy = bc_destroy,

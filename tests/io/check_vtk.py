@@ -20,16 +20,23 @@ EXPECTED = {"pressure": 1, "velocity": 3, "displacement": 3,
             "particle_id": 1, "acceleration": 3}
 
 
-def read_one(path):
-    """Child process: read a file, print its arrays as repr() or fail."""
+def watch(reader):
+    """The list that the errors and warnings VTK reports while `reader`
+    runs are appended to (tests/mpi/check_mpi.py uses it too)."""
     from vtkmodules.vtkCommonCore import vtkCommand
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
     problems = []
-    reader = vtkXMLPolyDataReader()
     for event in (vtkCommand.ErrorEvent, vtkCommand.WarningEvent):
         reader.AddObserver(event, lambda obj, ev: problems.append(ev))
         reader.GetExecutive().AddObserver(event,
                                           lambda obj, ev: problems.append(ev))
+    return problems
+
+
+def read_one(path):
+    """Child process: read a file, print its arrays as repr() or fail."""
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    reader = vtkXMLPolyDataReader()
+    problems = watch(reader)
     reader.SetFileName(path)
     reader.Update()
     if problems:

@@ -14,13 +14,15 @@
 #include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
-/* F from positions for the particles, images mirrored, P for every point */
-static void deformation_and_stress(tl_csph *m, long n) {
+/* F from positions for the particles, images mirrored, ghosts' from their
+ * owners, P for every point */
+static sph_status deformation_and_stress(tl_csph *m, long n, sph_error *err) {
   tl_reference *ref = &m->ref;
   long ne = (long)ref->n_ext;
   int dim = m->sim->scene->dimension;
   if (ne > n) /* image positions and momenta from their sources */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->x, 3, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* F = grad_0 x (seed 001 eq. 9) */
@@ -33,6 +35,7 @@ static void deformation_and_stress(tl_csph *m, long n) {
   }
   if (ne > n) /* the images' F mirror their sources' */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->F, 9, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];
@@ -41,6 +44,7 @@ static void deformation_and_stress(tl_csph *m, long n) {
                         sph_mat3_det(m->F + 9 * a), m->P + 9 * a);
     tl_force_matrix(ref, (size_t)a);
   }
+  return SPH_OK;
 }
 
 static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
@@ -48,7 +52,7 @@ static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
   sph_sim *sim = m->sim;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
-  deformation_and_stress(m, n);
+  SPH_TRY(deformation_and_stress(m, n, err));
   tl_conservative_force(&m->ref, m->dp);
   return tl_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
 }
@@ -70,7 +74,7 @@ static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
 
 static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
-  deformation_and_stress(m, (long)sim->ps->n);
+  SPH_TRY(deformation_and_stress(m, (long)sim->ps->n, err));
   return tl_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
 }
 
@@ -136,6 +140,7 @@ const sph_method_ops tl_csph_method_ops = {
     .title = "Total-Lagrangian corrected SPH, displacement-based (baseline)",
     .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 2, eq. 8-11",
     .conserves_angular_momentum = 1,
+    .distributed = 1,
     .fields = TL_OUTPUT_FIELDS,
     .setup = tl_csph_setup,
     .stable_dt = tl_csph_stable_dt,

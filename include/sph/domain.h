@@ -1,0 +1,92 @@
+/* Distributed runs: the one place that calls MPI (issue 20). Particles are
+ * partitioned by recursive coordinate bisection of their reference
+ * positions, balanced by count; a rank keeps its owned particles and, for
+ * the total-Lagrangian methods, the ghosts: every particle within one
+ * kernel support of an owned one in the reference configuration. The
+ * ghost set and the exchange pattern are fixed at set-up.
+ *
+ * Without MPI (built with SPH_MPI=OFF, or started without a launcher) the
+ * process is rank 0 of 1, sph_sim.domain is NULL and every call below taking
+ * a domain is a no-op that returns its input: the serial path is unchanged. */
+#ifndef SPH_DOMAIN_H
+#define SPH_DOMAIN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sph/neighbors.h"
+#include "sph/particles.h"
+#include "sph/status.h"
+
+typedef struct sph_domain sph_domain;
+
+/* Starts MPI when the process was started by a launcher (mpirun); returns
+ * SPH_ERR_UNSUPPORTED when it was but the build has no MPI. */
+sph_status sph_domain_init(int *argc, char ***argv, sph_error *err);
+void sph_domain_finalize(void);
+/* This process's rank and the rank count (0 and 1 without MPI). */
+int sph_domain_world_rank(void);
+int sph_domain_world_size(void);
+
+/* Partitions *ps (every particle, the same on every rank, in storage
+ * order) over the ranks: *ps becomes this rank's owned particles in the
+ * same relative order; rank 0 keeps the whole set for output
+ * (sph_domain_global). Ghosts are the particles of the same body within
+ * `support` of an owned one (strictly, as sph_neighbors_build). Refuses a
+ * rank count for which a rank would hold more ghosts than owned particles. */
+sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
+                             double support, sph_error *err);
+void sph_domain_destroy(sph_domain *d);
+
+int sph_domain_rank(const sph_domain *d);
+int sph_domain_size(const sph_domain *d);
+
+/* The ghosts (0 for NULL), their reference positions (3 per ghost),
+ * volumes, bodies and particle ids, grouped by owner. */
+size_t sph_domain_ghosts(const sph_domain *d);
+const double *sph_domain_ghost_X(const sph_domain *d);
+const double *sph_domain_ghost_volume(const sph_domain *d);
+const int32_t *sph_domain_ghost_body(const sph_domain *d);
+const int64_t *sph_domain_ghost_id(const sph_domain *d);
+/* The halo over all ranks (collective): values sent per exchange of one
+ * double per ghost (the ghosts of every rank), messages per exchange, and
+ * the most ghosts and owned particles of a rank. */
+typedef struct sph_halo {
+  double values, messages, max_ghosts, max_owned;
+} sph_halo;
+sph_halo sph_domain_halo(sph_domain *d);
+
+/* Sorts each of the first n lists of nl, built over the owned particles
+ * followed by the ghosts, by the particles' storage index in the whole set:
+ * pair sums then run in the order of the serial run. */
+void sph_domain_sort_lists(const sph_domain *d, sph_neighbors *nl, size_t n);
+
+/* Sets the ghosts' ncomp values, field + ncomp * n_owned onwards, from
+ * their owners' (non-blocking point to point). */
+sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
+                               sph_error *err);
+
+/* Global minimum and maximum; sums of count values added in rank order
+ * (the same bits for a fixed rank count). */
+double sph_domain_min(sph_domain *d, double v);
+double sph_domain_max(sph_domain *d, double v);
+void sph_domain_sum(sph_domain *d, double *v, int count);
+/* Root's value on every rank. */
+int sph_domain_bcast_int(sph_domain *d, int v);
+
+/* Every rank learns whether any failed: the error of the lowest failing
+ * rank is returned on all (st itself for NULL). */
+sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err);
+
+/* Wall seconds this rank spent in halo exchanges, reductions and gathers
+ * (waiting for the other ranks included). */
+double sph_domain_seconds(const sph_domain *d);
+
+/* Rank 0's whole particle set (NULL elsewhere and for NULL). */
+sph_particles *sph_domain_global(const sph_domain *d);
+/* Gathers every allocated field and the flags of `local` into rank 0's
+ * whole set, each particle at its storage index of the serial run. */
+sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
+                             sph_error *err);
+
+#endif

@@ -1,0 +1,628 @@
+/* Domain decomposition over MPI ranks (issue 20): recursive coordinate
+ * bisection of the reference positions balanced by count, ghost layers of
+ * one kernel support found with the cell-list search, a fixed halo exchange
+ * with MPI_Irecv/MPI_Isend, reductions in rank order and the gather of the
+ * output fields to rank 0. Every MPI call of sph is in this file. */
+#include "sph/domain.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef SPH_HAVE_MPI
+#include <mpi.h>
+#endif
+
+static int world_rank = 0, world_size = 1, mpi_started = 0;
+
+/* started by a launcher: the environment OpenMPI, MPICH and PMIx set */
+static int launched_size(void) {
+  const char *names[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"};
+  for (size_t i = 0; i < sizeof names / sizeof *names; ++i) {
+    const char *v = getenv(names[i]);
+    if (v && *v)
+      return atoi(v);
+  }
+  return getenv("PMIX_RANK") ? 2 : 0;
+}
+
+sph_status sph_domain_init(int *argc, char ***argv, sph_error *err) {
+  int launched = launched_size();
+#ifdef SPH_HAVE_MPI
+  if (launched <= 0)
+    return SPH_OK; /* serial: MPI is never started */
+  int provided;
+  if (MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided) !=
+      MPI_SUCCESS)
+    return sph_error_set(err, SPH_ERR_IO, "MPI_Init failed");
+  mpi_started = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+  return SPH_OK;
+#else
+  (void)argc, (void)argv;
+  if (launched > 1)
+    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
+                         "started by mpirun with %d ranks, but this sph was "
+                         "built without MPI (cmake -DSPH_MPI=ON with "
+                         "libopenmpi-dev installed)",
+                         launched);
+  return SPH_OK;
+#endif
+}
+
+void sph_domain_finalize(void) {
+#ifdef SPH_HAVE_MPI
+  if (mpi_started)
+    MPI_Finalize();
+  mpi_started = 0;
+#endif
+}
+
+int sph_domain_world_rank(void) { return world_rank; }
+int sph_domain_world_size(void) { return world_size; }
+
+struct sph_domain {
+  int rank, size, dim;
+  size_t n;           /* owned */
+  size_t ng;          /* ghosts */
+  int64_t *gidx;      /* storage index in the whole set: owned, then ghosts */
+  double *gX, *gV;    /* ghosts' reference positions and volumes */
+  int32_t *gbody;     /* ghosts' bodies */
+  int64_t *gid;       /* ghosts' particle ids */
+  int *recv_count;    /* ghosts owned by each rank */
+  int *recv_off;      /* their first ghost */
+  int *send_count;    /* owned particles each rank holds as ghosts */
+  int *send_off;      /* their first entry of send_idx */
+  int32_t *send_idx;  /* owned indices to send, grouped by rank */
+  size_t nsend;       /* entries of send_idx */
+  double *buf;        /* packed sends, 9 per entry */
+  void *req;          /* 2 size requests */
+  sph_particles *all; /* rank 0: the whole set */
+  int *all_count, *all_off; /* rank 0: owned per rank (doubles: scaled) */
+  int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
+  double *gbuf;             /* rank 0: 9 per particle, gathered */
+  int *counts, *offs;       /* rank 0: per-gather counts and offsets */
+  double seconds;           /* in exchanges, reductions and gathers */
+  double *sums;             /* 16 per rank: sph_domain_sum's gather */
+};
+
+int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
+double sph_domain_seconds(const sph_domain *d) { return d ? d->seconds : 0.0; }
+int sph_domain_size(const sph_domain *d) { return d ? d->size : 1; }
+size_t sph_domain_ghosts(const sph_domain *d) { return d ? d->ng : 0; }
+const double *sph_domain_ghost_X(const sph_domain *d) { return d->gX; }
+const double *sph_domain_ghost_volume(const sph_domain *d) { return d->gV; }
+const int32_t *sph_domain_ghost_body(const sph_domain *d) { return d->gbody; }
+const int64_t *sph_domain_ghost_id(const sph_domain *d) { return d->gid; }
+sph_particles *sph_domain_global(const sph_domain *d) {
+  return d ? d->all : NULL;
+}
+
+sph_halo sph_domain_halo(sph_domain *d) {
+  sph_halo h = {0.0, 0.0, 0.0, 0.0};
+  if (!d)
+    return h;
+  double v[2] = {(double)d->nsend, 0.0};
+  for (int q = 0; q < d->size; ++q)
+    v[1] += d->send_count[q] > 0;
+  sph_domain_sum(d, v, 2);
+  h.values = v[0];
+  h.messages = v[1];
+  h.max_ghosts = sph_domain_max(d, (double)d->ng);
+  h.max_owned = sph_domain_max(d, (double)d->n);
+  return h;
+}
+
+void sph_domain_destroy(sph_domain *d) {
+  if (!d)
+    return;
+  free(d->gidx);
+  free(d->gX);
+  free(d->gV);
+  free(d->gbody);
+  free(d->gid);
+  free(d->recv_count);
+  free(d->recv_off);
+  free(d->send_count);
+  free(d->send_off);
+  free(d->send_idx);
+  free(d->buf);
+  free(d->req);
+  sph_particles_destroy(d->all);
+  free(d->all_count);
+  free(d->all_off);
+  free(d->all_gidx);
+  free(d->gbuf);
+  free(d->counts);
+  free(d->offs);
+  free(d->sums);
+  free(d);
+}
+
+/* ---- recursive coordinate bisection ----------------------------------- */
+
+typedef struct rcb_key {
+  double x;
+  int64_t i;
+} rcb_key;
+
+static int cmp_rcb(const void *pa, const void *pb) {
+  const rcb_key *a = pa, *b = pb;
+  if (a->x != b->x)
+    return a->x < b->x ? -1 : 1;
+  return (a->i > b->i) - (a->i < b->i);
+}
+
+/* owner of the n particles idx: halves of the ranks get shares of the
+ * particles in proportion, cut across the longest side of their box
+ * (ties by storage index, so every rank computes the same partition) */
+static void rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
+                int nranks, int *owner) {
+  if (nranks == 1) {
+    for (size_t i = 0; i < n; ++i)
+      owner[k[i].i] = rank0;
+    return;
+  }
+  double lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < dim; ++c) {
+      lo[c] = fmin(lo[c], X[3 * k[i].i + c]);
+      hi[c] = fmax(hi[c], X[3 * k[i].i + c]);
+    }
+  int axis = 0;
+  for (int c = 1; c < dim; ++c)
+    if (hi[c] - lo[c] > hi[axis] - lo[axis])
+      axis = c;
+  for (size_t i = 0; i < n; ++i)
+    k[i].x = X[3 * k[i].i + axis];
+  qsort(k, n, sizeof *k, cmp_rcb);
+  int nlo = nranks / 2;
+  size_t cut = n * (size_t)nlo / (size_t)nranks;
+  rcb(X, dim, k, cut, rank0, nlo, owner);
+  rcb(X, dim, k + cut, n - cut, rank0 + nlo, nranks - nlo, owner);
+}
+
+#ifdef SPH_HAVE_MPI
+
+/* the ghosts of rank r: particles of the same body within `support` of an
+ * owned one, from a cell-list search over the owned particles and those in
+ * their box widened by `support`; flags ghost[i] = 1 in the whole set */
+static sph_status find_ghosts(const sph_particles *ps, const int *owner, int r,
+                              double support, char *ghost, sph_error *err) {
+  size_t N = ps->n;
+  int dim = ps->dim;
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  double lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < N; ++i)
+    for (int c = 0; owner[i] == r && c < dim; ++c) {
+      lo[c] = fmin(lo[c], X[3 * i + c]);
+      hi[c] = fmax(hi[c], X[3 * i + c]);
+    }
+  size_t nc = 0;
+  int64_t *cand = malloc((N ? N : 1) * sizeof *cand);
+  for (size_t i = 0; cand && i < N; ++i) {
+    int in = 1;
+    for (int c = 0; c < dim; ++c)
+      in &= X[3 * i + c] >= lo[c] - support && X[3 * i + c] <= hi[c] + support;
+    if (in)
+      cand[nc++] = (int64_t)i;
+  }
+  double *cx = malloc(3 * (nc ? nc : 1) * sizeof *cx);
+  int32_t *cb = malloc((nc ? nc : 1) * sizeof *cb);
+  sph_neighbors *nl = NULL;
+  sph_status st = cand && cx && cb
+                      ? sph_neighbors_create(&nl, err)
+                      : sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  for (size_t j = 0; st == SPH_OK && j < nc; ++j) {
+    memcpy(cx + 3 * j, X + 3 * cand[j], 3 * sizeof *cx);
+    cb[j] = ps->body[cand[j]];
+  }
+  if (st == SPH_OK)
+    st = sph_neighbors_build(nl, cx, nc, dim, support, cb, SPH_PAIRS_SAME_BODY,
+                             err);
+  for (size_t j = 0; st == SPH_OK && j < nc; ++j) {
+    if (owner[cand[j]] != r)
+      continue;
+    for (size_t k = nl->offset[j]; k < nl->offset[j + 1]; ++k) {
+      int64_t b = cand[nl->index[k]];
+      if (owner[b] != r)
+        ghost[b] = 1;
+    }
+  }
+  sph_neighbors_destroy(nl);
+  free(cand);
+  free(cx);
+  free(cb);
+  return st;
+}
+
+/* this rank's owned particles as a set of their own, in storage order */
+static sph_status owned_set(const sph_particles *ps, const sph_domain *d,
+                            sph_particles **out, sph_error *err) {
+  SPH_TRY(sph_particles_create(out, d->n, ps->dim, err));
+  sph_particles *o = *out;
+  for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
+    if (!ps->field[f])
+      continue;
+    SPH_TRY(sph_particles_require(o, (sph_field)f, err));
+    size_t nc = (size_t)sph_field_components((sph_field)f);
+    for (size_t a = 0; a < d->n; ++a)
+      memcpy(o->field[f] + nc * a, ps->field[f] + nc * d->gidx[a],
+             nc * sizeof(double));
+  }
+  for (size_t a = 0; a < d->n; ++a) {
+    o->id[a] = ps->id[d->gidx[a]];
+    o->body[a] = ps->body[d->gidx[a]];
+    o->flags[a] = ps->flags[d->gidx[a]];
+  }
+  o->n = d->n;
+  return SPH_OK;
+}
+
+/* who needs what: ghost storage indices to their owners, answered with the
+ * owned indices to send */
+static sph_status exchange_plan(sph_domain *d, const int *owner,
+                                sph_error *err) {
+  int R = d->size;
+  d->recv_count = calloc((size_t)R, sizeof(int));
+  d->recv_off = calloc((size_t)R + 1, sizeof(int));
+  d->send_count = calloc((size_t)R, sizeof(int));
+  d->send_off = calloc((size_t)R + 1, sizeof(int));
+  d->req = malloc(2 * (size_t)R * sizeof(MPI_Request));
+  if (!d->recv_count || !d->recv_off || !d->send_count || !d->send_off ||
+      !d->req)
+    return sph_error_set(err, SPH_ERR_NOMEM, "halo plan");
+  for (size_t g = 0; g < d->ng; ++g)
+    d->recv_count[owner[d->gidx[d->n + g]]]++;
+  for (int q = 0; q < R; ++q)
+    d->recv_off[q + 1] = d->recv_off[q] + d->recv_count[q];
+  MPI_Alltoall(d->recv_count, 1, MPI_INT, d->send_count, 1, MPI_INT,
+               MPI_COMM_WORLD);
+  for (int q = 0; q < R; ++q)
+    d->send_off[q + 1] = d->send_off[q] + d->send_count[q];
+  d->nsend = (size_t)d->send_off[R];
+  int64_t *want = malloc((d->nsend ? d->nsend : 1) * sizeof *want);
+  d->send_idx = malloc((d->nsend ? d->nsend : 1) * sizeof *d->send_idx);
+  d->buf = malloc(9 * (d->nsend ? d->nsend : 1) * sizeof *d->buf);
+  if (!want || !d->send_idx || !d->buf) {
+    free(want);
+    return sph_error_set(err, SPH_ERR_NOMEM, "halo plan");
+  }
+  MPI_Alltoallv(d->gidx + d->n, d->recv_count, d->recv_off, MPI_INT64_T, want,
+                d->send_count, d->send_off, MPI_INT64_T, MPI_COMM_WORLD);
+  /* owned storage indices ascend: binary search */
+  for (size_t k = 0; k < d->nsend; ++k) {
+    size_t lo = 0, hi = d->n;
+    while (lo < hi) {
+      size_t mid = (lo + hi) / 2;
+      if (d->gidx[mid] < want[k])
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    d->send_idx[k] = (int32_t)lo;
+  }
+  free(want);
+  return SPH_OK;
+}
+
+/* rank 0 learns every rank's owned storage indices (the gather's map) */
+static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
+  int R = d->size, n = (int)d->n;
+  int fail = 0;
+  if (d->rank == 0) {
+    d->all_count = malloc((size_t)R * sizeof(int));
+    d->all_off = malloc(((size_t)R + 1) * sizeof(int));
+    d->counts = malloc((size_t)R * sizeof(int));
+    d->offs = malloc((size_t)R * sizeof(int));
+    d->all_gidx = malloc((N ? N : 1) * sizeof(int64_t));
+    d->gbuf = malloc(9 * (N ? N : 1) * sizeof(double));
+    fail = !d->all_count || !d->all_off || !d->counts || !d->offs ||
+           !d->all_gidx || !d->gbuf;
+  }
+  sph_status st = fail ? sph_error_set(err, SPH_ERR_NOMEM, "gather") : SPH_OK;
+  SPH_TRY(sph_domain_agree(d, st, err));
+  MPI_Gather(&n, 1, MPI_INT, d->all_count, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (d->rank == 0) {
+    d->all_off[0] = 0;
+    for (int q = 0; q < R; ++q)
+      d->all_off[q + 1] = d->all_off[q] + d->all_count[q];
+  }
+  MPI_Gatherv(d->gidx, n, MPI_INT64_T, d->all_gidx, d->all_count, d->all_off,
+              MPI_INT64_T, 0, MPI_COMM_WORLD);
+  return SPH_OK;
+}
+
+sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
+                             double support, sph_error *err) {
+  *out = NULL;
+  sph_particles *all = *ps;
+  size_t N = all->n;
+  sph_domain *d = calloc(1, sizeof *d);
+  int *owner = malloc((N ? N : 1) * sizeof *owner);
+  char *ghost = calloc(N ? N : 1, 1);
+  rcb_key *k = malloc((N ? N : 1) * sizeof *k);
+  sph_status st = d && owner && ghost && k
+                      ? SPH_OK
+                      : sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
+  if (d) {
+    d->rank = world_rank;
+    d->size = world_size;
+    d->dim = all->dim;
+    d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
+    if (!d->sums)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
+  }
+  if (st == SPH_OK) {
+    for (size_t i = 0; i < N; ++i)
+      k[i] = (rcb_key){0.0, (int64_t)i};
+    rcb(all->field[SPH_FIELD_POSITION0], all->dim, k, N, 0, world_size, owner);
+    st = find_ghosts(all, owner, world_rank, support, ghost, err);
+  }
+  /* owned in storage order, then ghosts by owner and storage order */
+  for (size_t i = 0; st == SPH_OK && i < N; ++i) {
+    d->n += owner[i] == world_rank;
+    d->ng += ghost[i] != 0;
+  }
+  if (st == SPH_OK) {
+    size_t m = d->n + d->ng ? d->n + d->ng : 1;
+    d->gidx = malloc(m * sizeof *d->gidx);
+    d->gX = malloc(3 * (d->ng + 1) * sizeof *d->gX);
+    d->gV = malloc((d->ng + 1) * sizeof *d->gV);
+    d->gbody = malloc((d->ng + 1) * sizeof *d->gbody);
+    d->gid = malloc((d->ng + 1) * sizeof *d->gid);
+    if (!d->gidx || !d->gX || !d->gV || !d->gbody || !d->gid)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
+  }
+  if (st == SPH_OK) {
+    size_t a = 0;
+    for (size_t i = 0; i < N; ++i)
+      if (owner[i] == world_rank)
+        d->gidx[a++] = (int64_t)i;
+    /* ghosts by owner (a counting sort), each owner's in storage order */
+    size_t *at = calloc((size_t)world_size + 1, sizeof *at);
+    if (!at)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
+    for (size_t i = 0; at && i < N; ++i)
+      at[owner[i] + 1] += ghost[i] != 0;
+    for (int q = 0; at && q < world_size; ++q)
+      at[q + 1] += at[q];
+    for (size_t i = 0; at && i < N; ++i)
+      if (ghost[i])
+        d->gidx[d->n + at[owner[i]]++] = (int64_t)i;
+    free(at);
+    for (size_t j = 0; st == SPH_OK && j < d->ng; ++j) {
+      size_t i = (size_t)d->gidx[d->n + j];
+      memcpy(d->gX + 3 * j, all->field[SPH_FIELD_POSITION0] + 3 * i,
+             3 * sizeof *d->gX);
+      d->gV[j] = all->field[SPH_FIELD_VOLUME0][i];
+      d->gbody[j] = all->body[i];
+      d->gid[j] = all->id[i];
+    }
+  }
+  /* a halo larger than the domain: more ranks than useful */
+  long worst = -1;
+  if (st == SPH_OK && (d->ng > d->n || d->n == 0))
+    worst = world_rank;
+  st = sph_domain_agree(d, st, err);
+  long any = -1;
+  if (st == SPH_OK) {
+    MPI_Allreduce(&worst, &any, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+    if (any >= 0)
+      st = sph_error_set(err, SPH_ERR_RANGE,
+                         "%d ranks are more than useful for %zu particles: "
+                         "rank %ld would own no particle or hold more ghost "
+                         "particles (one kernel support around its own) than "
+                         "particles it owns; run on fewer ranks",
+                         world_size, N, any);
+  }
+  if (st == SPH_OK)
+    st = exchange_plan(d, owner, err);
+  st = sph_domain_agree(d, st, err);
+  sph_particles *mine = NULL;
+  if (st == SPH_OK)
+    st = owned_set(all, d, &mine, err);
+  st = sph_domain_agree(d, st, err);
+  if (st == SPH_OK)
+    st = gather_plan(d, N, err);
+  free(owner);
+  free(ghost);
+  free(k);
+  if (st != SPH_OK) {
+    sph_particles_destroy(mine);
+    sph_domain_destroy(d);
+    return st;
+  }
+  /* rank 0 keeps the whole set for the outputs */
+  if (world_rank == 0)
+    d->all = all;
+  else
+    sph_particles_destroy(all);
+  *ps = mine;
+  *out = d;
+  return SPH_OK;
+}
+
+sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
+                               sph_error *err) {
+  if (!d)
+    return SPH_OK;
+  double t0 = MPI_Wtime();
+  MPI_Request *req = d->req;
+  int nr = 0;
+  size_t nc = (size_t)ncomp;
+  for (int q = 0; q < d->size; ++q)
+    if (d->recv_count[q])
+      MPI_Irecv(field + nc * (d->n + (size_t)d->recv_off[q]),
+                ncomp * d->recv_count[q], MPI_DOUBLE, q, 7, MPI_COMM_WORLD,
+                &req[nr++]);
+  long ns = (long)d->nsend;
+#pragma omp parallel for schedule(static)
+  for (long k = 0; k < ns; ++k)
+    memcpy(d->buf + nc * (size_t)k, field + nc * (size_t)d->send_idx[k],
+           nc * sizeof(double));
+  for (int q = 0; q < d->size; ++q)
+    if (d->send_count[q])
+      MPI_Isend(d->buf + nc * (size_t)d->send_off[q], ncomp * d->send_count[q],
+                MPI_DOUBLE, q, 7, MPI_COMM_WORLD, &req[nr++]);
+  int rc = MPI_Waitall(nr, req, MPI_STATUSES_IGNORE);
+  d->seconds += MPI_Wtime() - t0;
+  if (rc != MPI_SUCCESS)
+    return sph_error_set(err, SPH_ERR_IO, "halo exchange failed");
+  return SPH_OK;
+}
+
+double sph_domain_min(sph_domain *d, double v) {
+  double out = v;
+  if (!d)
+    return out;
+  double t0 = MPI_Wtime();
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  d->seconds += MPI_Wtime() - t0;
+  return out;
+}
+
+double sph_domain_max(sph_domain *d, double v) {
+  double out = v;
+  if (d)
+    MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return out;
+}
+
+void sph_domain_sum(sph_domain *d, double *v, int count) {
+  if (!d || count <= 0 || count > 16)
+    return;
+  double mine[16], *all = d->sums;
+  memcpy(mine, v, (size_t)count * sizeof *v);
+  MPI_Allgather(mine, count, MPI_DOUBLE, all, count, MPI_DOUBLE,
+                MPI_COMM_WORLD);
+  for (int c = 0; c < count; ++c) {
+    double s = 0.0;
+    for (int q = 0; q < d->size; ++q)
+      s += all[q * count + c];
+    v[c] = s;
+  }
+}
+
+int sph_domain_bcast_int(sph_domain *d, int v) {
+  if (d)
+    MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return v;
+}
+
+sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
+  if (!d)
+    return st;
+  int mine = st != SPH_OK ? d->rank : d->size, first = d->size;
+  double t0 = MPI_Wtime();
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  d->seconds += MPI_Wtime() - t0;
+  if (first == d->size)
+    return SPH_OK;
+  sph_error e;
+  if (first == d->rank && err)
+    e = *err;
+  else if (first == d->rank)
+    sph_error_set(&e, st, "rank %d failed", d->rank);
+  MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, MPI_COMM_WORLD);
+  if (err)
+    *err = e;
+  return e.code != SPH_OK ? e.code : SPH_ERR_IO;
+}
+
+sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
+                             sph_error *err) {
+  if (!d)
+    return SPH_OK;
+  sph_status st = SPH_OK;
+  sph_particles *all = d->all;
+  double t0 = MPI_Wtime();
+  for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
+    /* the reference positions and volumes never change */
+    if (!local->field[f] || f == SPH_FIELD_POSITION0 || f == SPH_FIELD_VOLUME0)
+      continue;
+    int nc = sph_field_components((sph_field)f);
+    if (d->rank == 0) {
+      for (int q = 0; q < d->size; ++q) {
+        d->counts[q] = nc * d->all_count[q];
+        d->offs[q] = nc * d->all_off[q];
+      }
+      if (st == SPH_OK)
+        st = sph_particles_require(all, (sph_field)f, err);
+    }
+    MPI_Gatherv(local->field[f], nc * (int)local->n, MPI_DOUBLE, d->gbuf,
+                d->counts, d->offs, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (d->rank == 0 && st == SPH_OK) {
+      size_t N = all->n, w = (size_t)nc;
+      for (size_t k = 0; k < N; ++k)
+        memcpy(all->field[f] + w * (size_t)d->all_gidx[k], d->gbuf + w * k,
+               w * sizeof(double));
+    }
+  }
+  MPI_Gatherv(local->flags, (int)local->n, MPI_UINT32_T, d->gbuf, d->all_count,
+              d->all_off, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  if (d->rank == 0) {
+    const uint32_t *fl = (const uint32_t *)d->gbuf;
+    for (size_t k = 0; k < all->n; ++k)
+      all->flags[d->all_gidx[k]] = fl[k];
+  }
+  d->seconds += MPI_Wtime() - t0;
+  return sph_domain_agree(d, st, err);
+}
+
+#else /* without MPI: one rank, no domain is ever made */
+
+sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
+                             double support, sph_error *err) {
+  (void)ps, (void)support, (void)rcb;
+  *out = NULL;
+  return sph_error_set(err, SPH_ERR_UNSUPPORTED, "built without MPI");
+}
+
+sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
+                               sph_error *err) {
+  (void)d, (void)field, (void)ncomp, (void)err;
+  return SPH_OK;
+}
+
+double sph_domain_min(sph_domain *d, double v) { return (void)d, v; }
+double sph_domain_max(sph_domain *d, double v) { return (void)d, v; }
+void sph_domain_sum(sph_domain *d, double *v, int count) {
+  (void)d, (void)v, (void)count;
+}
+int sph_domain_bcast_int(sph_domain *d, int v) { return (void)d, v; }
+sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
+  (void)d, (void)err;
+  return st;
+}
+sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
+                             sph_error *err) {
+  (void)d, (void)local, (void)err;
+  return SPH_OK;
+}
+
+#endif
+
+/* ascending storage index within each list: insertion sort of the usual
+ * few tens of entries */
+void sph_domain_sort_lists(const sph_domain *d, sph_neighbors *nl, size_t n) {
+  if (!d)
+    return;
+  const int64_t *key = d->gidx;
+  long m = (long)n;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < m; ++a) {
+    int32_t *v = nl->index + nl->offset[a];
+    size_t k = nl->offset[a + 1] - nl->offset[a];
+    for (size_t i = 1; i < k; ++i) {
+      int32_t x = v[i];
+      size_t j = i;
+      for (; j > 0 && key[v[j - 1]] > key[x]; --j)
+        v[j] = v[j - 1];
+      v[j] = x;
+    }
+  }
+}

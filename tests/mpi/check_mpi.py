@@ -1,0 +1,132 @@
+#!/usr/bin/python3
+"""Compares a run over MPI ranks with the serial run of the same scene,
+reading the files with VTK's own readers (python3-vtk9): the .pvd names a
+.pvtp per output time at the serial times; each .pvtp (VTK's parallel
+PolyData reader) lists RANKS pieces that read without a VTK error or warning
+and together hold the serial particle count and arrays; every value equals
+the serial one (matched by particle_id) within REL_TOL of the array's
+largest magnitude; the PNG frames (rank 0, from the gathered particles)
+and probes.csv equal the serial files; energy.csv has the
+serial rows, the momenta equal and the energies within REL_TOL (sums over
+ranks in another order). Prints the largest relative difference measured.
+Usage: check_mpi.py SERIAL_DIR MPI_DIR SCENE RANKS REL_TOL"""
+import csv
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                "..", "io"))
+from check_vtk import watch  # noqa: E402
+
+
+def fail(msg):
+    sys.exit("check_mpi: " + msg)
+
+
+def read(path):
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPPolyDataReader
+    reader = (vtkXMLPPolyDataReader() if path.endswith(".pvtp")
+              else vtkXMLPolyDataReader())
+    problems = watch(reader)
+    reader.SetFileName(path)
+    reader.Update()
+    if problems:
+        fail("VTK reported %s reading %s" % (problems, path))
+    poly = reader.GetOutput()
+
+    def values(a):  # no numpy in Debian's python3-vtk9 dependencies
+        nc = a.GetNumberOfComponents()
+        return [a.GetTuple(i) for i in range(a.GetNumberOfTuples())], nc
+
+    arrays = {"Points": values(poly.GetPoints().GetData())}
+    pd = poly.GetPointData()
+    for i in range(pd.GetNumberOfArrays()):
+        arrays[pd.GetArray(i).GetName()] = values(pd.GetArray(i))
+    if "particle_id" not in arrays:
+        fail("%s has no particle_id" % path)
+    ids = [int(t[0]) for t in arrays["particle_id"][0]]
+    return poly.GetNumberOfPoints(), ids, arrays
+
+
+def pvd(path):
+    root = ET.parse(path).getroot()
+    return [(float(d.get("timestep")), d.get("file"))
+            for d in root.iter("DataSet")]
+
+
+def rel_diff(a, b):
+    """largest |a - b| over the largest |a| of an array"""
+    scale = max((abs(x) for t in a for x in t), default=0.0) or 1.0
+    return max((abs(x - y) for s, t in zip(a, b) for x, y in zip(s, t)),
+               default=0.0) / scale
+
+
+def main():
+    if len(sys.argv) != 6:
+        fail(__doc__)
+    serial, par, scene, ranks, tol = sys.argv[1:4] + [int(sys.argv[4]),
+                                                      float(sys.argv[5])]
+    s_series, p_series = (pvd(os.path.join(d, scene + ".pvd"))
+                          for d in (serial, par))
+    if [t for t, _ in s_series] != [t for t, _ in p_series]:
+        fail("output times differ: %s vs %s" % (s_series, p_series))
+    worst = 0.0
+    for (t, sf), (_, pf) in zip(s_series, p_series):
+        if not pf.endswith(".pvtp"):
+            fail("%s is not a .pvtp" % pf)
+        pieces = [p.get("Source") for p in
+                  ET.parse(os.path.join(par, pf)).getroot().iter("Piece")]
+        if len(pieces) != ranks:
+            fail("%s lists %d pieces, not %d" % (pf, len(pieces), ranks))
+        for p in pieces:
+            if not os.path.exists(os.path.join(par, p)):
+                fail("%s names the missing %s" % (pf, p))
+        ns, sids, sa = read(os.path.join(serial, sf))
+        np_, pids, pa = read(os.path.join(par, pf))
+        if ns != np_ or sorted(sids) != sorted(pids):
+            fail("%s: %d particles, serial %d" % (pf, np_, ns))
+        if {k: v[1] for k, v in sa.items()} != {k: v[1] for k, v in pa.items()}:
+            fail("%s: arrays %s, serial %s" % (pf, sorted(pa), sorted(sa)))
+        at = {pid: i for i, pid in enumerate(pids)}
+        for name, (vals, _) in sa.items():
+            mine = [pa[name][0][at[pid]] for pid in sids]
+            d = rel_diff(vals, mine)
+            worst = max(worst, d)
+            if d > tol:
+                fail("%s at t = %g: %s differs from serial by %g (relative)"
+                     % (pf, t, name, d))
+    frames = sorted(os.listdir(os.path.join(serial, "frames")))
+    if not frames or frames != sorted(os.listdir(os.path.join(par, "frames"))):
+        fail("frames/ holds %s, serial %s" % (
+            sorted(os.listdir(os.path.join(par, "frames"))), frames))
+    for f in frames:
+        with open(os.path.join(serial, "frames", f), "rb") as a, \
+                open(os.path.join(par, "frames", f), "rb") as b:
+            if a.read() != b.read():
+                fail("frames/%s differs from the serial run's" % f)
+    with open(os.path.join(serial, "probes.csv")) as a, \
+            open(os.path.join(par, "probes.csv")) as b:
+        if a.read() != b.read():
+            fail("probes.csv differs from the serial run's")
+    with open(os.path.join(serial, "energy.csv")) as a, \
+            open(os.path.join(par, "energy.csv")) as b:
+        ra, rb = list(csv.reader(a)), list(csv.reader(b))
+    if len(ra) != len(rb) or ra[0] != rb[0]:
+        fail("energy.csv rows or columns differ")
+    ediff = 0.0
+    for c in range(len(ra[0])):
+        u = [float(x[c]) for x in ra[1:]]
+        v = [float(x[c]) for x in rb[1:]]
+        if c >= 4 and u != v:
+            fail("energy.csv: %s differs from the serial run's" % ra[0][c])
+        ediff = max(ediff, rel_diff([(x,) for x in u], [(x,) for x in v]))
+    if ediff > tol:
+        fail("energy.csv: energies differ by %g (relative)" % ediff)
+    print("check_mpi: %d ranks, %d frames, %d particles: fields max relative "
+          "difference %g, energies %g" % (ranks, len(s_series), ns, worst,
+                                          ediff))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# sph run over MPI ranks (mpirun, oversubscribed on the machine's cores):
+# the twisting column with tl-csph on 2 and 4 ranks gives the serial run's
+# files (check_mpi.py: fields, frames and probes identical, energies to 1e-12
+# relative, the .pvtp series read by VTK with the serial particles and
+# arrays); the same rank count twice writes the same bytes; --overwrite
+# removes a 4-rank run's pieces; what does not run over ranks yet is
+# refused with exit 2 before anything is written. Usage:
+# run_mpi_test.sh SPH SOURCE_DIR
+set -u
+sph=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+check() { # name, command...
+  local name=$1
+  shift
+  if "$@" >"$work/out.txt" 2>&1; then
+    echo "ok   $name"
+  else
+    echo "FAIL $name"
+    tail -20 "$work/out.txt"
+    fails=$((fails + 1))
+  fi
+}
+mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
+[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+run=(run twisting_column --quiet --set 'method={name: tl-csph}'
+  --set time.end=0.05 --set output.every=0.01 --set output.png.width=320
+  --set output.png.height=180 --set output.png.mp4=false
+  --set 'output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]')
+
+OMP_NUM_THREADS=1 "$sph" "${run[@]}" --out "$work/serial" >/dev/null ||
+  { echo "FAIL serial run"; exit 1; }
+for n in 2 4; do
+  check "np $n runs" "${mpi[@]}" -np $n "$sph" "${run[@]}" --out "$work/np$n"
+  check "np $n equals serial" /usr/bin/python3 "$src/tests/mpi/check_mpi.py" \
+    "$work/serial" "$work/np$n" twisting_column $n 1e-12
+  cat "$work/out.txt"
+done
+
+# the same rank count and thread count: the same bytes
+check "np 2 again" "${mpi[@]}" -np 2 "$sph" "${run[@]}" --out "$work/np2b"
+same_bytes() {
+  for f in "$work/np2"/* "$work/np2"/frames/*; do
+    b=${f#"$work/np2/"}
+    case $b in summary.json | scene_used.yaml | frames) continue ;; esac
+    cmp -s "$f" "$work/np2b/$b" || { echo "$b differs"; return 1; }
+  done
+}
+check "np 2 twice: identical files" same_bytes
+
+# --overwrite removes the pieces of a 4-rank run before a 2-rank one
+check "np 2 --overwrite of np 4" "${mpi[@]}" -np 2 "$sph" "${run[@]}" \
+  --out "$work/np4" --overwrite
+no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
+check "no stale pieces" no_stale
+
+# refusals: exit 2 on every rank, the folder never made
+refused() { # name, sph args...
+  local out=$work/refused
+  rm -rf "$out"
+  "${mpi[@]}" -np "${np:-2}" "$sph" "$@" --out "$out" >"$work/ref.txt" 2>&1
+  local rc=$?
+  if [ $rc -ne 2 ] || [ -e "$out" ] || ! grep -q "$expect" "$work/ref.txt"; then
+    echo "rc $rc, wanted 2; folder made: $([ -e "$out" ] && echo yes || echo no)"
+    cat "$work/ref.txt"
+    return 1
+  fi
+}
+expect="tl-jst does not run over MPI ranks yet"
+check "tl-jst refused" refused run twisting_column --quiet
+expect="symmetry planes"
+check "symmetry planes refused" refused run swinging_cube --quiet \
+  --set 'method={name: tl-csph}'
+expect="more than useful"
+np=4 check "too many ranks refused" refused run twisting_column --quiet \
+  --set 'method={name: tl-csph}' --set 'bodies.0.particles.count=[3,7,3]'
+expect="checkpoints are not written over MPI"
+check "checkpoints refused" refused run twisting_column --quiet \
+  --set 'method={name: tl-csph}' --set output.checkpoint_every=0.01
+check_other() {
+  "${mpi[@]}" -np 2 "$sph" check twisting_column >"$work/ref.txt" 2>&1
+  [ $? -eq 2 ] && grep -q "only 'sph run' works over MPI" "$work/ref.txt"
+}
+check "sph check under mpirun refused" check_other
+
+total=11
+echo "$((total - fails)) passed, $fails failed"
+[ $fails -eq 0 ]
