@@ -62,7 +62,8 @@ enum {
   SPH_OPT_MP4,
   SPH_OPT_KEYS,
   SPH_OPT_MAX_MEMORY,
-  SPH_OPT_RESOLVED
+  SPH_OPT_RESOLVED,
+  SPH_OPT_CASE /* bench: --case TEXT */
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows

@@ -450,6 +450,7 @@ static void remove_dir_files(const char *dir) {
 typedef struct bench_args {
   int quick, threads;
   const char *json;
+  const char *only; /* run only the cases whose name contains it */
 } bench_args;
 
 static int bench_option(void *ctx, int id, const char *val) {
@@ -461,6 +462,9 @@ static int bench_option(void *ctx, int id, const char *val) {
   case SPH_OPT_JSON:
     b->json = val;
     return SPH_EXIT_OK;
+  case SPH_OPT_CASE:
+    b->only = val;
+    return SPH_EXIT_OK;
   case SPH_OPT_THREADS:
     return sph_app_count("bench", "threads", val, 1024, &b->threads);
   default:
@@ -469,23 +473,37 @@ static int bench_option(void *ctx, int id, const char *val) {
 }
 
 static const int bench_allowed[] = {SPH_OPT_QUICK, SPH_OPT_JSON,
-                                    SPH_OPT_THREADS, 0};
+                                    SPH_OPT_THREADS, SPH_OPT_CASE, 0};
 static const sph_app_command bench_command = {
     "bench",
-    "usage: sph bench [--quick] [--json FILE] [--threads N]\n"
-    "  throughput, split and memory of a fixed suite of the shipped scenes\n",
+    "usage: sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
+    "  throughput, split and memory of a fixed suite of the shipped scenes\n"
+    "  (--case: only the cases whose name contains TEXT)\n",
     bench_allowed, bench_option, NULL};
 
 int sph_cmd_bench(int argc, char **argv) {
-  bench_args b = {0, 0, NULL};
+  bench_args b = {0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   int quick = b.quick, threads = b.threads;
   const char *json = b.json;
-  const bench_case *cases = quick ? quick_cases : full_cases;
-  int ncases = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
+  const bench_case *suite = quick ? quick_cases : full_cases;
+  int nsuite = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
                      : (int)(sizeof full_cases / sizeof *full_cases);
+  /* the suite, or with --case the cases whose name contains the text */
+  bench_case *cases = malloc((size_t)nsuite * sizeof *cases);
+  int ncases = 0;
+  for (int c = 0; cases && c < nsuite; ++c)
+    if (!b.only || strstr(suite[c].name, b.only))
+      cases[ncases++] = suite[c];
+  if (!cases || !ncases) {
+    if (cases)
+      fprintf(stderr, "sph bench: no case of the %s suite is named '%s'\n",
+              quick ? "quick" : "full", b.only);
+    free(cases);
+    return cases ? SPH_EXIT_USAGE : SPH_EXIT_IO;
+  }
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   int thr[2] = {1, threads ? threads : (int)(cores > 0 ? cores : 1)};
   int nthr = thr[1] == 1 ? 1 : 2;
@@ -493,6 +511,7 @@ int sph_cmd_bench(int argc, char **argv) {
   if (!mkdtemp(dir)) {
     fprintf(stderr, "sph bench: cannot create a temporary folder: %s\n",
             strerror(errno));
+    free(cases);
     return SPH_EXIT_IO;
   }
   /* the resident set of a process that sets up the smallest scene (the
@@ -508,6 +527,7 @@ int sph_cmd_bench(int argc, char **argv) {
          nthr > 1 ? thr[1] : 0, baseline_kb / 1024.0);
   bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
   if (!res) {
+    free(cases);
     remove_dir_files(dir);
     return SPH_EXIT_IO;
   }
@@ -530,6 +550,7 @@ int sph_cmd_bench(int argc, char **argv) {
     rc = SPH_EXIT_IO;
   }
   free(res);
+  free(cases);
   remove_dir_files(dir);
   return rc;
 }
