@@ -478,7 +478,8 @@ static const sph_app_command bench_command = {
     "bench",
     "usage: sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
     "  throughput, split and memory of a fixed suite of the shipped scenes\n"
-    "  (--case: only the cases whose name contains TEXT)\n",
+    "  (--case: only the case named TEXT, else those whose name contains "
+    "it)\n",
     bench_allowed, bench_option, NULL};
 
 int sph_cmd_bench(int argc, char **argv) {
@@ -491,11 +492,15 @@ int sph_cmd_bench(int argc, char **argv) {
   const bench_case *suite = quick ? quick_cases : full_cases;
   int nsuite = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
                      : (int)(sizeof full_cases / sizeof *full_cases);
-  /* the suite, or with --case the cases whose name contains the text */
+  /* the suite, or with --case the case of that name, else the cases whose
+   * name contains the text */
   bench_case *cases = malloc((size_t)nsuite * sizeof *cases);
-  int ncases = 0;
+  int ncases = 0, exact = 0;
+  for (int c = 0; b.only && c < nsuite; ++c)
+    exact |= !strcmp(suite[c].name, b.only);
   for (int c = 0; cases && c < nsuite; ++c)
-    if (!b.only || strstr(suite[c].name, b.only))
+    if (!b.only || (exact ? !strcmp(suite[c].name, b.only)
+                          : strstr(suite[c].name, b.only) != NULL))
       cases[ncases++] = suite[c];
   if (!cases || !ncases) {
     if (cases)
@@ -521,10 +526,12 @@ int sph_cmd_bench(int argc, char **argv) {
   bench_result base;
   bench_run(&none, 1, dir, &base);
   long baseline_kb = base.max_rss_kb;
-  printf("sph bench (%s suite): %ld cores, threads %d%s%d; baseline "
+  char thr2[32] = "";
+  if (nthr > 1)
+    snprintf(thr2, sizeof thr2, " and %d", thr[1]);
+  printf("sph bench (%s suite): %ld cores, threads %d%s; baseline "
          "resident set %.0f MB\n",
-         quick ? "quick" : "full", cores, thr[0], nthr > 1 ? " and " : "",
-         nthr > 1 ? thr[1] : 0, baseline_kb / 1024.0);
+         quick ? "quick" : "full", cores, thr[0], thr2, baseline_kb / 1024.0);
   bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
   if (!res) {
     free(cases);
