@@ -92,11 +92,13 @@ static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
 }
 
 /* The pair sums of particle a over its neighbours (methods/tl_iact.h): the
- * uncorrected gradient of the vector field f (when f is not NULL) and the
- * pair part of the conservative force (when `force`); the constant
- * arguments of each caller specialise the loop. */
+ * uncorrected gradient of the vector field f (when f is not NULL), the
+ * pair part of the conservative force (when `force`) and the Laplacian of f
+ * with the per-slot weights `lap` (when not NULL); the constant arguments
+ * of each caller specialise the loop. */
 static inline void tl_pair_sums(const tl_reference *ref, size_t a,
-                                const double *f, int force, tl_sums *s) {
+                                const double *f, int force, const double *lap,
+                                tl_sums *s) {
   const sph_neighbors *nl = ref->nl;
   const double *Xa = ref->X + 3 * a;
   *s = (tl_sums){0};
@@ -109,6 +111,8 @@ static inline void tl_pair_sums(const tl_reference *ref, size_t a,
       tl_iact_gradient2(s, ref->w[k], f + 3 * a, f + 3 * b, r01, r2);
     if (force)
       tl_iact_force2(s, ref->w[k], ref->Qt + 9 * b, r01, r2);
+    if (lap)
+      tl_iact_laplacian2(s, lap[k], f + 3 * a, f + 3 * b);
   }
 }
 

@@ -21,13 +21,15 @@ static inline tl_v2 tl_v2_load(const double *p) {
   return v;
 }
 
-/* A particle's pair sums: the gradient rows (G_i0, G_i1) and G_i2, and the
- * force (f_0, f_1) and f_2. */
+/* A particle's pair sums: the gradient rows (G_i0, G_i1) and G_i2, the
+ * force (f_0, f_1) and f_2, and a Laplacian (l_0, l_1) and l_2. */
 typedef struct tl_sums {
   tl_v2 g01[3];
   double g2[3];
   tl_v2 f01;
   double f2;
+  tl_v2 l01;
+  double l2;
 } tl_sums;
 
 /* r_ab = X_a - X_b as (r_0, r_1) and r_2 */
@@ -54,6 +56,15 @@ static inline void tl_iact_force2(tl_sums *s, double w, const double Qtb[9],
   s->f01 += r0 * tl_v2_load(Qtb) + r1 * tl_v2_load(Qtb + 3) +
             wr2 * tl_v2_load(Qtb + 6);
   s->f2 += r0 * Qtb[2] + r1 * Qtb[5] + wr2 * Qtb[8];
+}
+
+/* the Laplacian sum l += lap_ab (f_b - f_a) of a vector field, in the
+ * order and arithmetic of the JST term's own sweep (terms/jst_dissipation.c)
+ * so that its L[u] is the same to the bit */
+static inline void tl_iact_laplacian2(tl_sums *s, double lap,
+                                      const double fa[3], const double fb[3]) {
+  s->l01 += lap * (tl_v2_load(fb) - tl_v2_load(fa));
+  s->l2 += lap * (fb[2] - fa[2]);
 }
 
 /* the sums as G[9] and f[3] */

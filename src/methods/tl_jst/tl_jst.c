@@ -79,19 +79,36 @@ static inline void particle_rates(tl_jst *m, size_t a, double G[9],
   }
 }
 
-/* one sweep for the momentum gradient and the force of eq. 42 */
-static void sweep_conservative(tl_jst *m, long n) {
+/* particle a's share of sweep_conservative; with `lap`, also L[p] */
+static inline __attribute__((always_inline)) void
+conservative_particle(tl_jst *m, size_t a, const double *lap) {
   const tl_reference *ref = &m->ref;
+  tl_sums s;
+  tl_pair_sums(ref, a, m->p, 1, lap, &s);
+  double G[9], f[3], self[3];
+  tl_sums_store(&s, G, f);
+  tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
+  for (int c = 0; c < 3; ++c)
+    f[c] += self[c];
+  particle_rates(m, a, G, f);
+  if (lap) {
+    m->lu_p[3 * a] = s.l01[0];
+    m->lu_p[3 * a + 1] = s.l01[1];
+    m->lu_p[3 * a + 2] = s.l2;
+  }
+}
+
+/* one sweep for the momentum gradient and the force of eq. 42, and the
+ * JST term's L[p] with them: one pass over the neighbour slots less */
+static void sweep_conservative(tl_jst *m, long n) {
+  if (m->lu_p) {
 #pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    tl_sums s;
-    tl_pair_sums(ref, (size_t)a, m->p, 1, &s);
-    double G[9], f[3], self[3];
-    tl_sums_store(&s, G, f);
-    tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
-    for (int c = 0; c < 3; ++c)
-      f[c] += self[c];
-    particle_rates(m, (size_t)a, G, f);
+    for (long a = 0; a < n; ++a)
+      conservative_particle(m, (size_t)a, m->lap);
+  } else {
+#pragma omp parallel for schedule(static)
+    for (long a = 0; a < n; ++a)
+      conservative_particle(m, (size_t)a, NULL);
   }
 }
 
@@ -226,6 +243,7 @@ static void tl_jst_destroy(sph_sim *sim) {
   tl_reference_destroy(&m->ref);
   free(m->H);
   free(m->lap);
+  free(m->lu_p);
   free(m->fgrad);
   free(m->fgrad_self);
   free(m->rev);
@@ -416,8 +434,11 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (amp)
     SPH_TRY(angular_momentum_projection_create(sim, err));
   if (need_p) {
+    if (m->force == TL_JST_CONSERVATIVE)
+      SPH_TRY(alloc_zero(&m->lu_p, 3 * ne, err));
     jst_params jp = {.nl = m->ref.nl,
                      .lap = m->lap,
+                     .lu = m->lu_p,
                      .V = m->ref.V,
                      .ncomp = 3,
                      .eps2 = e2p,
