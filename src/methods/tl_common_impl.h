@@ -94,8 +94,8 @@ static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
 /* The pair sums of particle a over its neighbours (methods/tl_iact.h): the
  * uncorrected gradient of the vector field f (when f is not NULL), the
  * pair part of the conservative force (when `force`) and the Laplacian of f
- * with the per-slot weights `lap` (when not NULL); the constant arguments
- * of each caller specialise the loop. */
+ * with the per-slot weights `lap` (when both are not NULL); the constant
+ * arguments of each caller specialise the loop. */
 static inline void tl_pair_sums(const tl_reference *ref, size_t a,
                                 const double *f, int force, const double *lap,
                                 tl_sums *s) {
@@ -107,12 +107,16 @@ static inline void tl_pair_sums(const tl_reference *ref, size_t a,
     tl_v2 r01;
     double r2;
     tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
-    if (f)
-      tl_iact_gradient2(s, ref->w[k], f + 3 * a, f + 3 * b, r01, r2);
+    if (f) {
+      const double *fa = f + 3 * a, *fb = f + 3 * b;
+      tl_v2 df01 = tl_v2_load(fb) - tl_v2_load(fa);
+      double df2 = fb[2] - fa[2];
+      tl_iact_gradient2(s, ref->w[k], df01, df2, r01, r2);
+      if (lap)
+        tl_iact_laplacian2(s, lap[k], df01, df2);
+    }
     if (force)
       tl_iact_force2(s, ref->w[k], ref->Qt + 9 * b, r01, r2);
-    if (lap)
-      tl_iact_laplacian2(s, lap[k], f + 3 * a, f + 3 * b);
   }
 }
 

@@ -41,11 +41,12 @@ static inline void tl_iact_pair_vector2(const double *Xa, const double *Xb,
   *r2 = Xa[2] - Xb[2];
 }
 
-/* tl_iact_gradient on the register sums (the same products and sums) */
-static inline void tl_iact_gradient2(tl_sums *s, double w, const double fa[3],
-                                     const double fb[3], tl_v2 r01, double r2) {
-  tl_v2 d01 = w * (tl_v2_load(fb) - tl_v2_load(fa));
-  double d2 = w * (fb[2] - fa[2]);
+/* tl_iact_gradient on the register sums (the same products and sums), from
+ * the difference f_b - f_a as (df_0, df_1) and df_2 */
+static inline void tl_iact_gradient2(tl_sums *s, double w, tl_v2 df01,
+                                     double df2, tl_v2 r01, double r2) {
+  tl_v2 d01 = w * df01;
+  double d2 = w * df2;
   s->g01[0] += d01[0] * r01;
   s->g01[1] += d01[1] * r01;
   s->g01[2] += d2 * r01;
@@ -65,10 +66,10 @@ static inline void tl_iact_force2(tl_sums *s, double w, const double Qtb[9],
 /* the Laplacian sum l += lap_ab (f_b - f_a) of a vector field, in the
  * order and arithmetic of the JST term's own sweep (terms/jst_dissipation.c)
  * so that its L[u] is the same to the bit */
-static inline void tl_iact_laplacian2(tl_sums *s, double lap,
-                                      const double fa[3], const double fb[3]) {
-  s->l01 += lap * (tl_v2_load(fb) - tl_v2_load(fa));
-  s->l2 += lap * (fb[2] - fa[2]);
+static inline void tl_iact_laplacian2(tl_sums *s, double lap, tl_v2 df01,
+                                      double df2) {
+  s->l01 += lap * df01;
+  s->l2 += lap * df2;
 }
 
 /* the sums as G[9] and f[3] */
