@@ -84,11 +84,17 @@ void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,
                            double g[3]);
 
 /* Q_a = P_a L_a, the stress the conservative force pairs with, stored
- * transposed (its columns contiguous) */
-static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
+ * transposed (its columns contiguous), from the stress P_a */
+static inline void tl_force_matrix_of(const tl_reference *ref, size_t a,
+                                      const double Pa[9]) {
   double Q[9];
-  sph_mat3_mul(ref->P + 9 * a, ref->L + 9 * a, Q);
+  sph_mat3_mul(Pa, ref->L + 9 * a, Q);
   sph_mat3_transpose(Q, ref->Qt + 9 * a);
+}
+
+/* the same from ref->P */
+static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
+  tl_force_matrix_of(ref, a, ref->P + 9 * a);
 }
 
 /* The pair sums of particle a over its neighbours (methods/tl_iact.h): the
