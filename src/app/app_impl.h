@@ -62,7 +62,8 @@ enum {
   SPH_OPT_MP4,
   SPH_OPT_KEYS,
   SPH_OPT_MAX_MEMORY,
-  SPH_OPT_RESOLVED
+  SPH_OPT_RESOLVED,
+  SPH_OPT_CASE /* bench: --case TEXT */
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows
@@ -143,8 +144,8 @@ int sph_cmd_list(int argc, char **argv);
 int sph_cmd_study(int argc, char **argv);
 /* sph imgdiff A.png B.png [options]: 0 passed, 1 different, 2 bad input */
 int sph_cmd_imgdiff(int argc, char **argv);
-/* sph bench [--quick] [--json FILE] [--threads N]: 0 every case ran, 1 a
- * case failed, 2 usage, 3 I/O */
+/* sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]: 0 every case
+ * ran, 1 a case failed, 2 usage, 3 I/O */
 int sph_cmd_bench(int argc, char **argv);
 /* sph render RUN [options]: 0 done, 2 bad input (missing or damaged files),
  * 3 I/O */

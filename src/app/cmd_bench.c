@@ -13,6 +13,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "app/app_impl.h"
@@ -131,6 +132,7 @@ typedef struct bench_result {
   int threads;
   double setup_seconds, first_step_seconds, step_seconds, vtp_seconds,
       frame_seconds;
+  double step_cpu_seconds; /* the process's CPU time over the steps */
   int nparts;
   char part[BENCH_MAX_PARTS][48];
   double part_seconds[BENCH_MAX_PARTS];
@@ -184,6 +186,14 @@ static sph_status time_sink(const sph_sink_ops *ops, sph_sim *sim,
   return st;
 }
 
+/* CPU time of this process (all its threads) */
+static double cpu_seconds(void) {
+  struct timespec ts;
+  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0)
+    return 0.0;
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 /* the child: load, step, time; fills r */
 static void bench_child(const bench_case *c, int threads, const char *dir,
                         bench_result *r) {
@@ -220,10 +230,12 @@ static void bench_child(const bench_case *c, int threads, const char *dir,
     bench_result *before = calloc(1, sizeof *before);
     if (before)
       collect_parts(sim, before, NULL);
+    double c0 = cpu_seconds();
     t0 = sph_wtime();
     for (long k = 0; k < c->steps && st == SPH_OK; ++k)
       st = sph_sim_step(sim, scene->t_end - sim->t, &err);
     r->step_seconds = sph_wtime() - t0;
+    r->step_cpu_seconds = cpu_seconds() - c0;
     r->steps = (long)sim->steps - 1;
     collect_parts(sim, r, before);
     free(before);
@@ -303,10 +315,14 @@ static void print_row(const bench_case *c, const bench_result *r,
   /* below 10,000 particles the baseline's noise outweighs the state */
   if (r->particles >= 10000)
     snprintf(per, sizeof per, " (%.2f kB/p)", bytes / 1024.0);
+  /* below 100 % the threads waited for the cores (a shared machine) */
+  double cpu = r->step_seconds > 0.0 ? 100.0 * r->step_cpu_seconds /
+                                           (r->step_seconds * r->threads)
+                                     : 0.0;
   printf("  %-46s %2d thr %9ld p %6ld st %8.3f s %7.3f M p-st/s/thr  "
-         "setup %.2f s  first step %.3f s  peak %.0f MB%s",
+         "cpu %.0f %%  setup %.2f s  first step %.3f s  peak %.0f MB%s",
          c->name, r->threads, r->particles, r->steps, r->step_seconds,
-         per_thread_rate(r) / 1e6, r->setup_seconds, r->first_step_seconds,
+         per_thread_rate(r) / 1e6, cpu, r->setup_seconds, r->first_step_seconds,
          (double)r->max_rss_kb / 1024.0, per);
   if (c->frame)
     printf("  .vtp %.3f s  frame %.3f s", r->vtp_seconds, r->frame_seconds);
@@ -397,12 +413,12 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
       fprintf(f,
               ", \"threads\": %d, \"particles\": %ld, \"steps\": %ld, "
               "\"setup_seconds\": %.6g, \"first_step_seconds\": %.6g, "
-              "\"step_seconds\": %.6g, "
+              "\"step_seconds\": %.6g, \"step_cpu_seconds\": %.6g, "
               "\"particle_steps_per_second_per_thread\": %.6g, "
               "\"peak_rss_mb\": %.3f, \"bytes_per_particle\": %.6g",
               r->threads, r->particles, r->steps, r->setup_seconds,
-              r->first_step_seconds, r->step_seconds, per_thread_rate(r),
-              r->max_rss_kb / 1024.0,
+              r->first_step_seconds, r->step_seconds, r->step_cpu_seconds,
+              per_thread_rate(r), r->max_rss_kb / 1024.0,
               (double)(r->max_rss_kb - baseline_kb) * 1024.0 /
                   (double)r->particles);
       if (cases[c].frame)
@@ -450,6 +466,7 @@ static void remove_dir_files(const char *dir) {
 typedef struct bench_args {
   int quick, threads;
   const char *json;
+  const char *only; /* run only the cases whose name contains it */
 } bench_args;
 
 static int bench_option(void *ctx, int id, const char *val) {
@@ -461,6 +478,9 @@ static int bench_option(void *ctx, int id, const char *val) {
   case SPH_OPT_JSON:
     b->json = val;
     return SPH_EXIT_OK;
+  case SPH_OPT_CASE:
+    b->only = val;
+    return SPH_EXIT_OK;
   case SPH_OPT_THREADS:
     return sph_app_count("bench", "threads", val, 1024, &b->threads);
   default:
@@ -469,23 +489,42 @@ static int bench_option(void *ctx, int id, const char *val) {
 }
 
 static const int bench_allowed[] = {SPH_OPT_QUICK, SPH_OPT_JSON,
-                                    SPH_OPT_THREADS, 0};
+                                    SPH_OPT_THREADS, SPH_OPT_CASE, 0};
 static const sph_app_command bench_command = {
     "bench",
-    "usage: sph bench [--quick] [--json FILE] [--threads N]\n"
-    "  throughput, split and memory of a fixed suite of the shipped scenes\n",
+    "usage: sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
+    "  throughput, split and memory of a fixed suite of the shipped scenes\n"
+    "  (--case: only the case named TEXT, else those whose name contains "
+    "it)\n",
     bench_allowed, bench_option, NULL};
 
 int sph_cmd_bench(int argc, char **argv) {
-  bench_args b = {0, 0, NULL};
+  bench_args b = {0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
   int quick = b.quick, threads = b.threads;
   const char *json = b.json;
-  const bench_case *cases = quick ? quick_cases : full_cases;
-  int ncases = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
+  const bench_case *suite = quick ? quick_cases : full_cases;
+  int nsuite = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
                      : (int)(sizeof full_cases / sizeof *full_cases);
+  /* the suite, or with --case the case of that name, else the cases whose
+   * name contains the text */
+  bench_case *cases = malloc((size_t)nsuite * sizeof *cases);
+  int ncases = 0, exact = 0;
+  for (int c = 0; b.only && c < nsuite; ++c)
+    exact |= !strcmp(suite[c].name, b.only);
+  for (int c = 0; cases && c < nsuite; ++c)
+    if (!b.only || (exact ? !strcmp(suite[c].name, b.only)
+                          : strstr(suite[c].name, b.only) != NULL))
+      cases[ncases++] = suite[c];
+  if (!cases || !ncases) {
+    if (cases)
+      fprintf(stderr, "sph bench: no case of the %s suite is named '%s'\n",
+              quick ? "quick" : "full", b.only);
+    free(cases);
+    return cases ? SPH_EXIT_USAGE : SPH_EXIT_IO;
+  }
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   int thr[2] = {1, threads ? threads : (int)(cores > 0 ? cores : 1)};
   int nthr = thr[1] == 1 ? 1 : 2;
@@ -493,6 +532,7 @@ int sph_cmd_bench(int argc, char **argv) {
   if (!mkdtemp(dir)) {
     fprintf(stderr, "sph bench: cannot create a temporary folder: %s\n",
             strerror(errno));
+    free(cases);
     return SPH_EXIT_IO;
   }
   /* the resident set of a process that sets up the smallest scene (the
@@ -502,12 +542,15 @@ int sph_cmd_bench(int argc, char **argv) {
   bench_result base;
   bench_run(&none, 1, dir, &base);
   long baseline_kb = base.max_rss_kb;
-  printf("sph bench (%s suite): %ld cores, threads %d%s%d; baseline "
+  char thr2[32] = "";
+  if (nthr > 1)
+    snprintf(thr2, sizeof thr2, " and %d", thr[1]);
+  printf("sph bench (%s suite): %ld cores, threads %d%s; baseline "
          "resident set %.0f MB\n",
-         quick ? "quick" : "full", cores, thr[0], nthr > 1 ? " and " : "",
-         nthr > 1 ? thr[1] : 0, baseline_kb / 1024.0);
+         quick ? "quick" : "full", cores, thr[0], thr2, baseline_kb / 1024.0);
   bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
   if (!res) {
+    free(cases);
     remove_dir_files(dir);
     return SPH_EXIT_IO;
   }
@@ -530,6 +573,7 @@ int sph_cmd_bench(int argc, char **argv) {
     rc = SPH_EXIT_IO;
   }
   free(res);
+  free(cases);
   remove_dir_files(dir);
   return rc;
 }

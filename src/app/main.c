@@ -43,7 +43,7 @@ static void usage(FILE *out) {
           "          [--max-cluster N] [--diff OUT.png]\n"
           "                       compare two images (exit 0 same, 1 "
           "different)\n"
-          "  bench [--quick] [--json FILE] [--threads N]\n"
+          "  bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
           "                       throughput, split and memory of a fixed "
           "suite\n"
           "  render RUN_DIR [--field F] [--range R] [--width W] [--height H]\n"

@@ -37,6 +37,7 @@ static const struct option all_options[] = {
     {"keys", no_argument, NULL, SPH_OPT_KEYS},
     {"max-memory", required_argument, NULL, SPH_OPT_MAX_MEMORY},
     {"resolved", no_argument, NULL, SPH_OPT_RESOLVED},
+    {"case", required_argument, NULL, SPH_OPT_CASE},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 

@@ -328,7 +328,7 @@ void tl_conservative_force(const tl_reference *ref, double *dp) {
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s;
-    tl_pair_sums(ref, (size_t)a, NULL, 1, &s);
+    tl_pair_sums(ref, (size_t)a, NULL, 1, NULL, &s);
     double G[9], f[3], self[3];
     tl_sums_store(&s, G, f);
     tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);

@@ -86,19 +86,27 @@ void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,
                            double g[3]);
 
 /* Q_a = P_a L_a, the stress the conservative force pairs with, stored
- * transposed (its columns contiguous) */
-static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
+ * transposed (its columns contiguous), from the stress P_a */
+static inline void tl_force_matrix_of(const tl_reference *ref, size_t a,
+                                      const double Pa[9]) {
   double Q[9];
-  sph_mat3_mul(ref->P + 9 * a, ref->L + 9 * a, Q);
+  sph_mat3_mul(Pa, ref->L + 9 * a, Q);
   sph_mat3_transpose(Q, ref->Qt + 9 * a);
 }
 
+/* the same from ref->P */
+static inline void tl_force_matrix(const tl_reference *ref, size_t a) {
+  tl_force_matrix_of(ref, a, ref->P + 9 * a);
+}
+
 /* The pair sums of particle a over its neighbours (methods/tl_iact.h): the
- * uncorrected gradient of the vector field f (when f is not NULL) and the
- * pair part of the conservative force (when `force`); the constant
+ * uncorrected gradient of the vector field f (when f is not NULL), the
+ * pair part of the conservative force (when `force`) and the Laplacian of f
+ * with the per-slot weights `lap` (when both are not NULL); the constant
  * arguments of each caller specialise the loop. */
 static inline void tl_pair_sums(const tl_reference *ref, size_t a,
-                                const double *f, int force, tl_sums *s) {
+                                const double *f, int force, const double *lap,
+                                tl_sums *s) {
   const sph_neighbors *nl = ref->nl;
   const double *Xa = ref->X + 3 * a;
   *s = (tl_sums){0};
@@ -107,8 +115,14 @@ static inline void tl_pair_sums(const tl_reference *ref, size_t a,
     tl_v2 r01;
     double r2;
     tl_iact_pair_vector2(Xa, ref->X + 3 * b, &r01, &r2);
-    if (f)
-      tl_iact_gradient2(s, ref->w[k], f + 3 * a, f + 3 * b, r01, r2);
+    if (f) {
+      const double *fa = f + 3 * a, *fb = f + 3 * b;
+      tl_v2 df01 = tl_v2_load(fb) - tl_v2_load(fa);
+      double df2 = fb[2] - fa[2];
+      tl_iact_gradient2(s, ref->w[k], df01, df2, r01, r2);
+      if (lap)
+        tl_iact_laplacian2(s, lap[k], df01, df2);
+    }
     if (force)
       tl_iact_force2(s, ref->w[k], ref->Qt + 9 * b, r01, r2);
   }

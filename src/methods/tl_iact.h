@@ -21,13 +21,17 @@ static inline tl_v2 tl_v2_load(const double *p) {
   return v;
 }
 
-/* A particle's pair sums: the gradient rows (G_i0, G_i1) and G_i2, and the
- * force (f_0, f_1) and f_2. */
+/* A particle's pair sums: the gradient rows (G_i0, G_i1), the last column
+ * (G_02, G_12) and G_22, the force (f_0, f_1) and f_2, and a Laplacian
+ * (l_0, l_1) and l_2. */
 typedef struct tl_sums {
   tl_v2 g01[3];
-  double g2[3];
+  tl_v2 g2_01;
+  double g22;
   tl_v2 f01;
   double f2;
+  tl_v2 l01;
+  double l2;
 } tl_sums;
 
 /* r_ab = X_a - X_b as (r_0, r_1) and r_2 */
@@ -37,14 +41,17 @@ static inline void tl_iact_pair_vector2(const double *Xa, const double *Xb,
   *r2 = Xa[2] - Xb[2];
 }
 
-/* tl_iact_gradient on the register sums */
-static inline void tl_iact_gradient2(tl_sums *s, double w, const double fa[3],
-                                     const double fb[3], tl_v2 r01, double r2) {
-  for (int i = 0; i < 3; ++i) {
-    double d = w * (fb[i] - fa[i]);
-    s->g01[i] += d * r01;
-    s->g2[i] += d * r2;
-  }
+/* tl_iact_gradient on the register sums (the same products and sums), from
+ * the difference f_b - f_a as (df_0, df_1) and df_2 */
+static inline void tl_iact_gradient2(tl_sums *s, double w, tl_v2 df01,
+                                     double df2, tl_v2 r01, double r2) {
+  tl_v2 d01 = w * df01;
+  double d2 = w * df2;
+  s->g01[0] += d01[0] * r01;
+  s->g01[1] += d01[1] * r01;
+  s->g01[2] += d2 * r01;
+  s->g2_01 += d01 * r2;
+  s->g22 += d2 * r2;
 }
 
 /* tl_iact_force on the register sums, with Q_b stored transposed */
@@ -56,13 +63,24 @@ static inline void tl_iact_force2(tl_sums *s, double w, const double Qtb[9],
   s->f2 += r0 * Qtb[2] + r1 * Qtb[5] + wr2 * Qtb[8];
 }
 
+/* the Laplacian sum l += lap_ab (f_b - f_a) of a vector field, in the
+ * order and arithmetic of the JST term's own sweep (terms/jst_dissipation.c)
+ * so that its L[u] is the same to the bit */
+static inline void tl_iact_laplacian2(tl_sums *s, double lap, tl_v2 df01,
+                                      double df2) {
+  s->l01 += lap * df01;
+  s->l2 += lap * df2;
+}
+
 /* the sums as G[9] and f[3] */
 static inline void tl_sums_store(const tl_sums *s, double G[9], double f[3]) {
   for (int i = 0; i < 3; ++i) {
     G[3 * i] = s->g01[i][0];
     G[3 * i + 1] = s->g01[i][1];
-    G[3 * i + 2] = s->g2[i];
   }
+  G[2] = s->g2_01[0];
+  G[5] = s->g2_01[1];
+  G[8] = s->g22;
   f[0] = s->f01[0];
   f[1] = s->f01[1];
   f[2] = s->f2;

@@ -13,7 +13,7 @@
 
 typedef struct jst {
   jst_params p;
-  double *lu; /* L[u] */
+  double *lu; /* L[u] (p.lu when the method sums it) */
   double *d;  /* D(u) */
 } jst;
 
@@ -73,7 +73,8 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   double cp = j->p.cp_now ? *j->p.cp_now : j->p.cp;
   double c2 = j->p.eps2 * cp * j->p.h;
   double c4 = j->p.eps4 * cp * j->p.h * j->p.h * j->p.h;
-  laplacian(j, j->p.lap, u, NULL, 0.0, 1.0, j->lu, n);
+  if (!j->p.lu)
+    laplacian(j, j->p.lap, u, NULL, 0.0, 1.0, j->lu, n);
   if (sim->mirror) { /* the images' Laplacians mirror their sources' */
     if (nc == 3)
       sph_mirror_vector(sim->mirror, j->lu);
@@ -123,7 +124,8 @@ static void jst_destroy(sph_term *term) {
   jst *j = term->data;
   if (!j)
     return;
-  free(j->lu);
+  if (!j->p.lu)
+    free(j->lu);
   free(j->d);
   free(j);
 }
@@ -153,10 +155,11 @@ sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
                                   sph_error *err) {
   jst *j = calloc(1, sizeof *j);
   size_t len = (size_t)p->ncomp * (p->nl->n ? p->nl->n : 1);
-  if (!j || !(j->lu = calloc(len, sizeof(double))) ||
+  if (!j || !(j->lu = p->lu ? p->lu : calloc(len, sizeof(double))) ||
       !(j->d = calloc(len, sizeof(double)))) {
     if (j) {
-      free(j->lu);
+      if (!p->lu)
+        free(j->lu);
       free(j);
     }
     return sph_error_set(err, SPH_ERR_NOMEM, "JST work arrays");

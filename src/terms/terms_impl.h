@@ -38,6 +38,10 @@ typedef struct jst_params {
    * (eq. 27) stays `lap` */
   const double *lap_sym;
   const double *cp_now; /* c_p of the step (NULL: cp) */
+  /* L[u] of the real particles summed by the method in its own pair sweep
+   * before the term runs, in this term's arithmetic (NULL: the term sums
+   * it); the term fills the mirror images' entries */
+  double *lu;
 } jst_params;
 sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
                                   sph_error *err);

@@ -26,7 +26,7 @@ static sph_status deformation_and_stress(tl_csph *m, long n, sph_error *err) {
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* F = grad_0 x (seed 001 eq. 9) */
-    tl_pair_sums(ref, (size_t)a, m->x, 0, &s);
+    tl_pair_sums(ref, (size_t)a, m->x, 0, NULL, &s);
     double F[9], unused[3];
     tl_sums_store(&s, F, unused);
     tl_iact_gradient_correct(F, ref->L + 9 * a);

@@ -41,16 +41,21 @@ static void refresh_images(tl_jst *m) {
                       m->fields == TL_JST_PF ? NULL : m->J);
 }
 
-/* P, and Q = P L for the conservative force, of every point */
-static void compute_stress(tl_jst *m, long n) {
+/* P, and Q = P L for the conservative force, of every point; the
+ * conservative force needs only Q, so its stages store P only when asked
+ * (the output fields): 144 bytes per point less to write */
+static void compute_stress(tl_jst *m, long n, int store_P) {
   int conservative = m->force == TL_JST_CONSERVATIVE;
+  store_P |= !conservative;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    double Ha[9], Ja;
+    double Ha[9], Ja, P[9];
     strain_measures(m, m->F, m->H, m->J, (size_t)a, Ha, &Ja);
-    sph_material_stress(m->ref.mat[a], m->F + 9 * a, Ha, Ja, m->P + 9 * a);
+    sph_material_stress(m->ref.mat[a], m->F + 9 * a, Ha, Ja, P);
+    if (store_P)
+      memcpy(m->P + 9 * a, P, sizeof P);
     if (conservative)
-      tl_force_matrix(&m->ref, (size_t)a);
+      tl_force_matrix_of(&m->ref, (size_t)a, P);
   }
 }
 
@@ -79,19 +84,36 @@ static inline void particle_rates(tl_jst *m, size_t a, double G[9],
   }
 }
 
-/* one sweep for the momentum gradient and the force of eq. 42 */
-static void sweep_conservative(tl_jst *m, long n) {
+/* particle a's share of sweep_conservative; with `lap`, also L[p] */
+static inline __attribute__((always_inline)) void
+conservative_particle(tl_jst *m, size_t a, const double *lap) {
   const tl_reference *ref = &m->ref;
+  tl_sums s;
+  tl_pair_sums(ref, a, m->p, 1, lap, &s);
+  double G[9], f[3], self[3];
+  tl_sums_store(&s, G, f);
+  tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
+  for (int c = 0; c < 3; ++c)
+    f[c] += self[c];
+  particle_rates(m, a, G, f);
+  if (lap) {
+    m->lu_p[3 * a] = s.l01[0];
+    m->lu_p[3 * a + 1] = s.l01[1];
+    m->lu_p[3 * a + 2] = s.l2;
+  }
+}
+
+/* one sweep for the momentum gradient and the force of eq. 42, and the
+ * JST term's L[p] with them: one pass over the neighbour slots less */
+static void sweep_conservative(tl_jst *m, long n) {
+  if (m->lu_p) {
 #pragma omp parallel for schedule(static)
-  for (long a = 0; a < n; ++a) {
-    tl_sums s;
-    tl_pair_sums(ref, (size_t)a, m->p, 1, &s);
-    double G[9], f[3], self[3];
-    tl_sums_store(&s, G, f);
-    tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
-    for (int c = 0; c < 3; ++c)
-      f[c] += self[c];
-    particle_rates(m, (size_t)a, G, f);
+    for (long a = 0; a < n; ++a)
+      conservative_particle(m, (size_t)a, m->lap);
+  } else {
+#pragma omp parallel for schedule(static)
+    for (long a = 0; a < n; ++a)
+      conservative_particle(m, (size_t)a, NULL);
   }
 }
 
@@ -153,7 +175,7 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   refresh_images(m);
-  compute_stress(m, (long)m->ref.n_ext);
+  compute_stress(m, (long)m->ref.n_ext, 0);
   m->sweep(m, n);
   /* X^chi of eq. 45: x^n, then x^n + dt / (2 rho0) (p^n + p*) for
    * TVD-RK2; SSP-RK3 takes the stage's x (no exact angular momentum) */
@@ -207,7 +229,7 @@ static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   tl_jst *m = sim->method_data;
   refresh_images(m);
-  compute_stress(m, (long)m->ref.n_ext);
+  compute_stress(m, (long)m->ref.n_ext, 1);
   tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
             m->fields == TL_JST_PF ? NULL : m->J, NULL);
   return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
@@ -226,6 +248,7 @@ static void tl_jst_destroy(sph_sim *sim) {
   tl_reference_destroy(&m->ref);
   free(m->H);
   free(m->lap);
+  free(m->lu_p);
   free(m->fgrad);
   free(m->fgrad_self);
   free(m->rev);
@@ -416,8 +439,11 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (amp)
     SPH_TRY(angular_momentum_projection_create(sim, err));
   if (need_p) {
+    if (m->force == TL_JST_CONSERVATIVE)
+      SPH_TRY(alloc_zero(&m->lu_p, 3 * ne, err));
     jst_params jp = {.nl = m->ref.nl,
                      .lap = m->lap,
+                     .lu = m->lu_p,
                      .V = m->ref.V,
                      .ncomp = 3,
                      .eps2 = e2p,

@@ -25,6 +25,9 @@ typedef struct tl_jst {
   double *fgrad;          /* eq. 31: grad W~1_b(X_a) per slot */
   double *fgrad_self;     /* eq. 31: grad W~1_a(X_a) per particle */
   size_t *rev;            /* eq. 31: slot of (b -> a) for slot (a -> b) */
+  /* L[p] for the JST term, summed in the conservative sweep (NULL: the
+   * term sums it) */
+  double *lu_p;
   /* the pair sweep of the chosen force, picked once at set-up */
   void (*sweep)(struct tl_jst *m, long n);
   /* state (particle fields) and its RK copies and rates */

@@ -32,7 +32,7 @@ static void deformation_and_stress(ul_csph *m, long n) {
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
-    tl_pair_sums(ref, (size_t)a, m->x, 0, &s);
+    tl_pair_sums(ref, (size_t)a, m->x, 0, NULL, &s);
     double f[9], unused[3];
     tl_sums_store(&s, f, unused);
     tl_iact_gradient_correct(f, ref->L + 9 * a);
