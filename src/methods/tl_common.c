@@ -720,7 +720,6 @@ tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
                    sph_status (*rates)(void *ctx, double t, sph_error *err),
                    sph_status (*constrain)(void *ctx, double t, sph_error *err),
                    void *ctx, sph_error *err) {
-  const sph_scene *s = sim->scene;
   *lf = (sph_leapfrog){.n = ref->n,
                        .x = ref->x,
                        .p = ref->p,
@@ -729,15 +728,39 @@ tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
                        .rates = rates,
                        .constrain = constrain,
                        .ctx = ctx};
-  if (s->has_body_force)
+  SPH_TRY(tl_external_terms_create(sim, ref, err));
+  return tl_essential_bc_attach(sim, ref, constrain, ctx, err);
+}
+
+sph_status tl_external_terms_create(sph_sim *sim, const tl_reference *ref,
+                                    sph_error *err) {
+  if (sim->scene->has_body_force)
     SPH_TRY(body_force_create(sim, ref->rho0, err));
-  if (s->contact.given)
+  if (sim->scene->contact.given)
     SPH_TRY(contact_create(sim, ref->rho0, err));
-  if (sph_scene_has_essential_bc(s)) {
-    SPH_TRY(essential_bc_create(sim, ref->rho0, err));
-    SPH_TRY(constrain(ctx, 0.0, err));
-  }
   return SPH_OK;
+}
+
+sph_status tl_essential_bc_attach(sph_sim *sim, const tl_reference *ref,
+                                  sph_status (*constrain)(void *ctx, double t,
+                                                          sph_error *err),
+                                  void *ctx, sph_error *err) {
+  if (!sph_scene_has_essential_bc(sim->scene))
+    return SPH_OK;
+  SPH_TRY(essential_bc_create(sim, ref->rho0, err));
+  /* the initial state honours the constraints */
+  return constrain(ctx, 0.0, err);
+}
+
+/* the finite-state check after an integrator step, timed with the step */
+static sph_status step_checked(sph_sim *sim, const tl_reference *ref, int timer,
+                               double integrator_seconds, sph_error *err) {
+  double t0 = sph_wtime();
+  sph_status st = tl_check_finite(ref, err);
+  sph_timer *tm = &sim->timers[timer];
+  tm->seconds += integrator_seconds + sph_wtime() - t0;
+  tm->calls++;
+  return st;
 }
 
 sph_status tl_leapfrog_step(sph_sim *sim, const tl_reference *ref,
@@ -745,12 +768,7 @@ sph_status tl_leapfrog_step(sph_sim *sim, const tl_reference *ref,
                             sph_error *err) {
   double s0 = lf->seconds;
   SPH_TRY(sph_leapfrog_step(lf, sim->t, dt, err));
-  double t0 = sph_wtime();
-  sph_status st = tl_check_finite(ref, err);
-  sph_timer *tm = &sim->timers[timer];
-  tm->seconds += lf->seconds - s0 + sph_wtime() - t0;
-  tm->calls++;
-  return st;
+  return step_checked(sim, ref, timer, lf->seconds - s0, err);
 }
 
 sph_status tl_leapfrog_derive(sph_sim *sim, const tl_reference *ref,
@@ -789,12 +807,7 @@ sph_status tl_rk_step(sph_sim *sim, const tl_reference *ref, sph_ode *ode,
                       sph_error *err) {
   double s0 = ode->seconds;
   SPH_TRY(integrate(ode, sim->t, dt, err));
-  double t0 = sph_wtime();
-  sph_status st = tl_check_finite(ref, err);
-  sph_timer *tm = &sim->timers[timer];
-  tm->seconds += ode->seconds - s0 + sph_wtime() - t0;
-  tm->calls++;
-  return st;
+  return step_checked(sim, ref, timer, ode->seconds - s0, err);
 }
 
 sph_status tl_rk_acceleration(sph_sim *sim, const tl_reference *ref,

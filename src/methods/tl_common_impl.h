@@ -195,6 +195,18 @@ tl_leapfrog_attach(sph_sim *sim, const tl_reference *ref, sph_leapfrog *lf,
                    sph_status (*constrain)(void *ctx, double t, sph_error *err),
                    void *ctx, sph_error *err);
 
+/* The external terms the scene asks for (body force, contact), acting on
+ * the momentum per reference volume. */
+sph_status tl_external_terms_create(sph_sim *sim, const tl_reference *ref,
+                                    sph_error *err);
+
+/* Essential boundary conditions imposed directly, when the scene has any,
+ * and the initial state constrained through `constrain`. */
+sph_status tl_essential_bc_attach(sph_sim *sim, const tl_reference *ref,
+                                  sph_status (*constrain)(void *ctx, double t,
+                                                          sph_error *err),
+                                  void *ctx, sph_error *err);
+
 /* tl_derive (J = det F) and, when the scene asks for it, the acceleration
  * from the rates of the current state (computed if lf holds none). */
 /* One leap-frog step and the finite-state check, their time added to the

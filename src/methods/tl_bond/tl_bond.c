@@ -277,7 +277,6 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-bond");
   sim->method_data = m;
   m->sim = sim;
-  const sph_scene *s = sim->scene;
   size_t n = sim->ps->n;
 
   /* options */
@@ -369,16 +368,8 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .cp_now = m->pair_speed ? &m->cp_now : NULL};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  if (s->has_body_force)
-    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (s->contact.given)
-    SPH_TRY(contact_create(sim, m->ref.rho0, err));
-  if (sph_scene_has_essential_bc(s)) {
-    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
-    /* the initial state honours the constraints */
-    SPH_TRY(tl_bond_constrain(m, 0.0, err));
-  }
-  return SPH_OK;
+  SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
+  return tl_essential_bc_attach(sim, &m->ref, tl_bond_constrain, m, err);
 }
 
 static int tl_bond_state(sph_sim *sim, sph_state_array *out) {

@@ -465,10 +465,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .project = jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  if (s->has_body_force)
-    SPH_TRY(body_force_create(sim, m->ref.rho0, err));
-  if (s->contact.given)
-    SPH_TRY(contact_create(sim, m->ref.rho0, err));
+  SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
   int planes = 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
@@ -477,13 +474,9 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     /* symmetry planes are constraints here, not mirror images */
     SPH_TRY(lagrange_projection_create(sim, &cloud, m->ref.rho0,
                                        lagrange_momentum, err));
-    SPH_TRY(tl_jst_constrain(m, 0.0, err));
-  } else if (sph_scene_has_essential_bc(s)) {
-    SPH_TRY(essential_bc_create(sim, m->ref.rho0, err));
-    /* the initial state honours the constraints */
-    SPH_TRY(tl_jst_constrain(m, 0.0, err));
+    return tl_jst_constrain(m, 0.0, err);
   }
-  return SPH_OK;
+  return tl_essential_bc_attach(sim, &m->ref, tl_jst_constrain, m, err);
 }
 
 static int tl_jst_state(sph_sim *sim, sph_state_array *out) {
