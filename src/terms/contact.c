@@ -218,6 +218,13 @@ sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
     sph_status st = !ct->box || !ct->cand || !ct->xc || !ct->bc
                         ? sph_error_set(err, SPH_ERR_NOMEM, "contact")
                         : sph_neighbors_create(&ct->nl, err);
+    /* room for the searches of the time steps, made here: every pair of
+     * the reference set within 1.5 contact distances (a contact lists
+     * only surface particles' pairs within one) */
+    if (st == SPH_OK)
+      st = sph_neighbors_build(ct->nl, ps->field[SPH_FIELD_POSITION0], n,
+                               ct->dim, 1.5 * ct->radius, NULL, SPH_PAIRS_ALL,
+                               err);
     if (st != SPH_OK) {
       contact_destroy(&t);
       return st;
