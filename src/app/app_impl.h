@@ -147,6 +147,10 @@ int sph_cmd_imgdiff(int argc, char **argv);
 /* sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]: 0 every case
  * ran, 1 a case failed, 2 usage, 3 I/O */
 int sph_cmd_bench(int argc, char **argv);
+/* Bytes per second of the STREAM triad over three arrays of `bytes` each on
+ * `threads` threads, the best of 0.3 s of repetitions (0 when they cannot be
+ * allocated). */
+double bench_memory_triad(int threads, size_t bytes);
 /* sph render RUN [options]: 0 done, 2 bad input (missing or damaged files),
  * 3 I/O */
 int sph_cmd_render(int argc, char **argv);
