@@ -664,11 +664,15 @@ double tl_stable_dt(const tl_reference *ref, const sph_sim *sim, double cfl,
 }
 
 sph_status tl_check_finite(const tl_reference *ref, sph_error *err) {
-  long n3 = 3 * (long)ref->n;
+  long n3 = 3 * (long)ref->n, first = n3;
+  /* the lowest non-finite entry, whatever the thread count */
+#pragma omp parallel for schedule(static) reduction(min : first)
   for (long i = 0; i < n3; ++i)
     if (!isfinite(ref->p[i]) || !isfinite(ref->x[i]))
-      return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "nan: non-finite state at particle %ld", i / 3);
+      first = i < first ? i : first;
+  if (first < n3)
+    return sph_error_set(err, SPH_ERR_NUMERIC,
+                         "nan: non-finite state at particle %ld", first / 3);
   return SPH_OK;
 }
 
