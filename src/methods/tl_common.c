@@ -282,7 +282,13 @@ sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
         else
           hi = mid;
       }
-      if (lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a)
+      /* a distributed run's lists ascend in the serial storage order,
+       * not in the local one: then look through b's list */
+      if (!(lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a))
+        for (lo = nl->offset[b]; lo < nl->offset[b + 1]; ++lo)
+          if (nl->index[lo] == (int32_t)a)
+            break;
+      if (lo < nl->offset[b + 1])
         rev[k] = lo;
       else
         ++missing;
