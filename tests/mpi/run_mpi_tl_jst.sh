@@ -9,8 +9,9 @@
 # that grow about linearly (measured: 4e-14 after the column's 290 steps,
 # 8e-14 after the punch's 534), so 1e-12 leaves a factor 10 and more, while a
 # ghost value from the wrong state or a missing exchange gives 1e-4 and more.
-# The symmetric force (its ghosts' P exchanged) likewise; the same rank count
-# twice writes the same bytes; eq31 and essential_bc lagrange are refused.
+# The symmetric force (its ghosts' P exchanged) and eq31 (its ghosts' kernel
+# gradients from their owners' coefficients) likewise; the same rank count
+# twice writes the same bytes; essential_bc lagrange is refused.
 # tl-bond (its ghosts' pair weights from their owners' coefficients, no
 # global sum) gives the serial files bit for bit but the energies (check_mpi.py
 # without --roundoff, as tl-csph), its zeroth-order correction is refused.
@@ -78,6 +79,8 @@ roundoff="1e-12 --roundoff"
 compare column twisting_column "$roundoff" 2 4 -- "${column[@]}"
 compare punch punch "$roundoff" 2 4 -- "${punch[@]}"
 compare symmetric twisting_column "$roundoff" 2 -- "${symmetric[@]}"
+compare eq31 punch "$roundoff" 2 -- "${punch[@]}" --set method.force=eq31 \
+  --set time.end=0.003
 compare bond twisting_column_bond 1e-12 2 4 -- "${bond[@]}"
 
 # the same rank count and thread count: the same bytes
@@ -104,8 +107,6 @@ refused() { # sph args...
     return 1
   fi
 }
-expect="force: eq31 does not run over MPI ranks yet"
-check "eq31 refused" refused "${column[@]}" --set method.force=eq31
 expect="essential_bc: lagrange does not run over MPI ranks yet"
 check "essential_bc lagrange refused" refused "${punch[@]}" \
   --set method.essential_bc=lagrange

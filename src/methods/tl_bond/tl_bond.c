@@ -14,7 +14,9 @@
  * M_a = I - sum_b (X_b - X_a) (x) q_ab, both fixed at set-up: a homogeneous
  * deformation x_b - x_a = F (X_b - X_a) gives F^c = F exactly. F itself is
  * integrated from eq. 24 and F^c is recomputed from it and the positions at
- * every stage (it does not replace F). */
+ * every stage (it does not replace F). Over MPI ranks (sph_domain) each
+ * stage exchanges the ghosts' x, p and P, and the ghosts' pair weights
+ * toward this rank's particles come from their owners' coefficients. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -213,31 +215,6 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
   return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "tl-bond arrays");
 }
 
-/* over MPI ranks: every point's W~1 and Laplacian coefficients, the
- * ghosts' from their owners (sph_correction_slot), SPH_CORRECTION_COEFS
- * each, exchanged in parts of at most 9 */
-static sph_status ghost_coefficients(sph_sim *sim, const sph_cloud *cloud,
-                                     int laplacian, double **out,
-                                     sph_error *err) {
-  const tl_reference *ref = &((tl_bond *)sim->method_data)->ref;
-  size_t ne = ref->n_ext, ni = ref->n_img, nc = SPH_CORRECTION_COEFS;
-  double *part = NULL;
-  SPH_TRY(alloc_zero(out, nc * ne, err));
-  SPH_TRY(alloc_zero(&part, 9 * ne, err));
-  double *coef = *out;
-  sph_status st = sph_correction_coefficients(cloud, laplacian, coef, err);
-  for (size_t j = 0; st == SPH_OK && j < nc; j += 9) {
-    size_t w = nc - j < 9 ? nc - j : 9;
-    for (size_t a = 0; a < ni; ++a)
-      memcpy(part + w * a, coef + nc * a + j, w * sizeof *part);
-    st = sph_domain_exchange(sim->domain, part, (int)w, err);
-    for (size_t a = ni; st == SPH_OK && a < ne; ++a)
-      memcpy(coef + nc * a + j, part + w * a, w * sizeof *part);
-  }
-  free(part);
-  return st;
-}
-
 /* the pair weights of eq. 22, 24, 27-28 and 37-39 in the reference
  * configuration */
 static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
@@ -246,7 +223,7 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
   const sph_neighbors *nl = ref->nl;
   size_t ne = ref->n_ext, count = nl->count;
   /* over MPI ranks the ghosts' rows are not whole: their slots toward this
-   * rank's particles come from their owners' coefficients */
+   * rank's particles come from their owners' coefficients (tl_ghost_slots) */
   sph_cloud cloud = {.n = ref->n_img,
                      .dim = sim->scene->dimension,
                      .x = ref->X,
@@ -254,7 +231,7 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
                      .id = ref->id,
                      .nl = nl,
                      .kernel = &sim->kernel};
-  double *g = NULL, *w = NULL, *wself = NULL, *lap = NULL, *coef = NULL;
+  double *g = NULL, *w = NULL, *wself = NULL, *lap = NULL;
   size_t *rev = NULL;
   sph_status st;
   if ((st = alloc_zero(&g, 3 * count, err)) != SPH_OK ||
@@ -269,8 +246,7 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
                                   err)) != SPH_OK ||
       (need_lap &&
        (st = sph_correction_laplacian(&cloud, lap, err)) != SPH_OK) ||
-      (sim->domain &&
-       (st = ghost_coefficients(sim, &cloud, need_lap, &coef, err)) != SPH_OK))
+      (st = tl_ghost_slots(sim, ref, &cloud, rev, g, lap, err)) != SPH_OK)
     goto done;
   for (size_t a = 0; a < cloud.n; ++a) {
     double *M = m->Mc + 9 * a;
@@ -282,23 +258,14 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
         r[c] = ref->X[3 * b + c] - ref->X[3 * a + c];
         r2 += r[c] * r[c];
       }
-      /* grad W~_a(X_b) and Lap W~_a(X_b): b's slot toward a */
-      double grev[3], lrev = 0.0;
-      if (b < cloud.n) {
-        memcpy(grev, g + 3 * rev[k], sizeof grev);
-        lrev = need_lap ? lap[rev[k]] : 0.0;
-      } else {
-        sph_correction_slot(&cloud, coef + SPH_CORRECTION_COEFS * b, b, a, grev,
-                            &lrev);
-      }
       for (int c = 0; c < 3; ++c) {
         m->gv[3 * k + c] = Vb * g[3 * k + c];
         if (symmetric) {
-          m->fa[3 * k + c] = 0.5 * Vb * (g[3 * k + c] - grev[c]);
+          m->fa[3 * k + c] = 0.5 * Vb * (g[3 * k + c] - g[3 * rev[k] + c]);
           m->fb[3 * k + c] = m->fa[3 * k + c];
         } else {
           m->fa[3 * k + c] = Vb * g[3 * k + c];
-          m->fb[3 * k + c] = -Vb * grev[c];
+          m->fb[3 * k + c] = -Vb * g[3 * rev[k] + c];
         }
         m->q[3 * k + c] = Vb * w[k] * r[c] / r2;
       }
@@ -307,12 +274,11 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
           M[3 * i + j] -= r[i] * m->q[3 * k + j];
       if (need_lap) {
         m->lap[k] = Vb * lap[k];
-        m->lap_sym[k] = 0.5 * Vb * (lap[k] + lrev);
+        m->lap_sym[k] = 0.5 * Vb * (lap[k] + lap[rev[k]]);
       }
     }
   }
 done:
-  free(coef);
   free(g);
   free(w);
   free(wself);

@@ -397,19 +397,19 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
              : m->force == TL_JST_EQ31       ? sweep_eq31
                                              : sweep_symmetric;
-  if (sim->domain && (m->force == TL_JST_EQ31 || bc == 1))
-    return sph_node_error(
-        sph_node_child(opt, bc == 1 ? "essential_bc" : "force"), err,
-        SPH_ERR_UNSUPPORTED,
-        "%s does not run over MPI ranks yet (force conservative, symmetric "
-        "or eq30 with essential_bc direct do); run without mpirun",
-        bc == 1 ? "essential_bc: lagrange" : "force: eq31");
+  if (sim->domain && bc == 1)
+    return sph_node_error(sph_node_child(opt, "essential_bc"), err,
+                          SPH_ERR_UNSUPPORTED,
+                          "essential_bc: lagrange does not run over MPI ranks "
+                          "yet (essential_bc: direct does); run without "
+                          "mpirun");
   if (m->force == TL_JST_EQ31) {
     SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
     SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
     SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
                                     m->fgrad_self, NULL, err));
     SPH_TRY(tl_reference_reverse_slots(&m->ref, &m->rev, err));
+    SPH_TRY(tl_ghost_slots(sim, &m->ref, &cloud, m->rev, m->fgrad, NULL, err));
   }
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
