@@ -81,7 +81,7 @@ compare punch punch "$roundoff" 2 4 -- "${punch[@]}"
 compare symmetric twisting_column "$roundoff" 2 -- "${symmetric[@]}"
 compare eq31 punch "$roundoff" 2 -- "${punch[@]}" --set method.force=eq31 \
   --set time.end=0.003
-compare bond twisting_column_bond 1e-12 2 4 -- "${bond[@]}"
+compare bond twisting_column_bond 1e-12 2 -- "${bond[@]}"
 
 # the same rank count and thread count: the same bytes
 check "punch np 2 again" "${mpi[@]}" -np 2 "$sph" "${punch[@]}" \
