@@ -195,6 +195,20 @@ static int w1_coefficients(const sph_cloud *c, size_t a, double rmin,
   return 0;
 }
 
+/* grad W~1_b(x_a) of slot (a -> b) from a's coefficients */
+static inline void w1_slot(const sph_cloud *c, const w1_coef *w, size_t a,
+                           size_t b, double out[3]) {
+  double rab[3], r, g[3];
+  pair_vector(c, a, b, rab, &r);
+  double Wb = sph_kernel_eval(c->kernel, r);
+  sph_kernel_gradient(c->kernel, rab, r, g);
+  double lin = 1.0 + sph_vec3_dot(w->beta, rab);
+  for (int k = 0; k < 3; ++k)
+    out[k] = w->dalpha[k] * lin * Wb +
+             w->alpha * (sph_vec3_dot(w->dbeta[k], rab) + w->beta[k]) * Wb +
+             w->alpha * lin * g[k];
+}
+
 sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
                                    double *grad, double *grad_self, double *L,
                                    sph_error *err) {
@@ -224,18 +238,8 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
       double W0 = sph_kernel_eval(c->kernel, 0.0);
       for (int k = 0; k < 3; ++k)
         gs[k] = (w.dalpha[k] + w.alpha * w.beta[k]) * W0;
-      for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-        double rab[3], r, g[3];
-        pair_vector(c, (size_t)a, (size_t)nl->index[s], rab, &r);
-        double Wb = sph_kernel_eval(c->kernel, r);
-        sph_kernel_gradient(c->kernel, rab, r, g);
-        double lin = 1.0 + sph_vec3_dot(w.beta, rab);
-        for (int k = 0; k < 3; ++k)
-          grad[3 * s + k] =
-              w.dalpha[k] * lin * Wb +
-              w.alpha * (sph_vec3_dot(w.dbeta[k], rab) + w.beta[k]) * Wb +
-              w.alpha * lin * g[k];
-      }
+      for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s)
+        w1_slot(c, &w, (size_t)a, (size_t)nl->index[s], grad + 3 * s);
     } else {
       /* raw or W~0 gradients and the moment M = sum V g (x) (x_b - x_a) */
       double S = 1.0, gam[3] = {0, 0, 0}, M[9] = {0};
@@ -403,54 +407,105 @@ static double solve_small(int m, double A[4][4], double b[4], const double s[4],
   return rc;
 }
 
+/* the coefficients alpha (sol[0..d-1]) and beta (sol[d]) of a's corrected
+ * Laplacian (A.2), -1 when its system is singular */
+static int laplacian_solution(const sph_cloud *c, size_t a, double rmin,
+                              double sol[4]) {
+  const sph_neighbors *nl = c->nl;
+  int d = c->dim, m = d + 1;
+  double h = c->kernel->h;
+  /* system A.5 with r_ab = X_b - X_a and right-hand side 2d (A.4) */
+  double A[4][4] = {{0}}, rhs[4] = {0};
+  rhs[d] = 2.0 * d;
+  for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
+    size_t b = (size_t)nl->index[s];
+    double rab[3], r;
+    pair_vector(c, a, b, rab, &r);
+    for (int k = 0; k < 3; ++k)
+      rab[k] = -rab[k];
+    double V = c->volume[b], r2 = r * r;
+    double lw = sph_kernel_laplacian(c->kernel, r);
+    for (int i = 0; i < d; ++i) {
+      for (int j = 0; j < d; ++j)
+        A[i][j] += V * rab[i] * rab[j];
+      A[i][d] += V * r2 * rab[i];
+      A[d][i] += V * r2 * rab[i];
+      rhs[i] -= V * rab[i] * lw;
+    }
+    A[d][d] += V * r2 * r2;
+    rhs[d] -= V * r2 * lw;
+  }
+  /* lengths in units of h make the system dimensionless */
+  double sc[4] = {1.0 / h, 1.0 / h, 1.0 / h, 1.0 / h};
+  sc[d] = 1.0 / (h * h);
+  return solve_small(m, A, rhs, sc, rmin, sol) < rmin ? -1 : 0;
+}
+
+/* Lap W~_b(X_a) = Lap W + alpha . r_ab + beta |r_ab|^2 (A.2) of slot
+ * (a -> b) from a's coefficients */
+static inline double laplacian_slot(const sph_cloud *c, const double sol[4],
+                                    size_t a, size_t b) {
+  double rab[3], r;
+  pair_vector(c, a, b, rab, &r);
+  double dot = 0.0;
+  for (int i = 0; i < c->dim; ++i)
+    dot -= sol[i] * rab[i];
+  return sph_kernel_laplacian(c->kernel, r) + dot + sol[c->dim] * r * r;
+}
+
 sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
                                     sph_error *err) {
   const sph_neighbors *nl = c->nl;
-  int d = c->dim, m = d + 1;
   long n = (long)c->n, bad = n;
-  double rmin = rcond_min(c), h = c->kernel->h;
+  double rmin = rcond_min(c);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    /* system A.5 with r_ab = X_b - X_a and right-hand side 2d (A.4) */
-    double A[4][4] = {{0}}, rhs[4] = {0}, sol[4] = {0};
-    rhs[d] = 2.0 * d;
-    for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-      size_t b = (size_t)nl->index[s];
-      double rab[3], r;
-      pair_vector(c, (size_t)a, b, rab, &r);
-      for (int k = 0; k < 3; ++k)
-        rab[k] = -rab[k];
-      double V = c->volume[b], r2 = r * r;
-      double lw = sph_kernel_laplacian(c->kernel, r);
-      for (int i = 0; i < d; ++i) {
-        for (int j = 0; j < d; ++j)
-          A[i][j] += V * rab[i] * rab[j];
-        A[i][d] += V * r2 * rab[i];
-        A[d][i] += V * r2 * rab[i];
-        rhs[i] -= V * rab[i] * lw;
-      }
-      A[d][d] += V * r2 * r2;
-      rhs[d] -= V * r2 * lw;
-    }
-    /* lengths in units of h make the system dimensionless */
-    double sc[4] = {1.0 / h, 1.0 / h, 1.0 / h, 1.0 / h};
-    sc[d] = 1.0 / (h * h);
-    if (solve_small(m, A, rhs, sc, rmin, sol) < rmin) {
+    double sol[4] = {0};
+    if (laplacian_solution(c, (size_t)a, rmin, sol)) {
       mark_bad(&bad, a);
       clear_slots(nl, (size_t)a, 1, lap);
       continue;
     }
-    /* Lap W~ = Lap W + alpha . r_ab + beta |r_ab|^2 (A.2) */
-    for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-      double rab[3], r;
-      pair_vector(c, (size_t)a, (size_t)nl->index[s], rab, &r);
-      double dot = 0.0;
-      for (int i = 0; i < d; ++i)
-        dot -= sol[i] * rab[i];
-      lap[s] = sph_kernel_laplacian(c->kernel, r) + dot + sol[d] * r * r;
-    }
+    for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s)
+      lap[s] = laplacian_slot(c, sol, (size_t)a, (size_t)nl->index[s]);
   }
   if (bad < n)
     return singular(c, bad, "Laplacian moment matrix", err);
   return SPH_OK;
+}
+
+sph_status sph_correction_coefficients(const sph_cloud *c, int laplacian,
+                                       double *coef, sph_error *err) {
+  long n = (long)c->n, bad = n;
+  double rmin = rcond_min(c);
+  int lap_bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : lap_bad)
+  for (long a = 0; a < n; ++a) {
+    double *co = coef + SPH_CORRECTION_COEFS * a;
+    w1_coef w;
+    int wrong = w1_coefficients(c, (size_t)a, rmin, &w) != 0;
+    memcpy(co, &w, sizeof w);
+    double sol[4] = {0};
+    if (laplacian && laplacian_solution(c, (size_t)a, rmin, sol)) {
+      wrong = 1;
+      lap_bad |= 1;
+    }
+    memcpy(co + 16, sol, sizeof sol);
+    if (wrong)
+      mark_bad(&bad, a);
+  }
+  if (bad < n)
+    return singular(c, bad,
+                    lap_bad ? "kernel or Laplacian moment matrix"
+                            : "kernel moment matrix",
+                    err);
+  return SPH_OK;
+}
+
+void sph_correction_slot(const sph_cloud *c, const double *coef, size_t a,
+                         size_t b, double grad[3], double *lap) {
+  w1_coef w;
+  memcpy(&w, coef, sizeof w);
+  w1_slot(c, &w, a, b, grad);
+  *lap = laplacian_slot(c, coef + 16, a, b);
 }

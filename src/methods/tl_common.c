@@ -282,7 +282,13 @@ sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
         else
           hi = mid;
       }
-      if (lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a)
+      /* a distributed run's lists ascend in the serial storage order,
+       * not in the local one: then look through b's list */
+      if (!(lo < nl->offset[b + 1] && nl->index[lo] == (int32_t)a))
+        for (lo = nl->offset[b]; lo < nl->offset[b + 1]; ++lo)
+          if (nl->index[lo] == (int32_t)a)
+            break;
+      if (lo < nl->offset[b + 1])
         rev[k] = lo;
       else
         ++missing;
@@ -290,6 +296,43 @@ sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
   if (missing)
     return sph_error_set(err, SPH_ERR_ARG, "neighbour lists are not symmetric");
   return SPH_OK;
+}
+
+sph_status tl_ghost_slots(const sph_sim *sim, const tl_reference *ref,
+                          const sph_cloud *cloud, const size_t *rev,
+                          double *grad, double *lap, sph_error *err) {
+  if (!sim->domain)
+    return SPH_OK;
+  size_t ne = ref->n_ext, ni = ref->n_img, nc = SPH_CORRECTION_COEFS;
+  double *coef = calloc(nc * ne + 1, sizeof *coef);
+  double *part = calloc(9 * ne + 1, sizeof *part);
+  sph_status st =
+      coef && part ? sph_correction_coefficients(cloud, lap != NULL, coef, err)
+                   : sph_error_set(err, SPH_ERR_NOMEM, "ghost coefficients");
+  st = sph_domain_agree(sim->domain, st, err);
+  /* the ghosts' from their owners, in parts of at most 9 */
+  for (size_t j = 0; st == SPH_OK && j < nc; j += 9) {
+    size_t w = nc - j < 9 ? nc - j : 9;
+    for (size_t a = 0; a < ni; ++a)
+      memcpy(part + w * a, coef + nc * a + j, w * sizeof *part);
+    st = sph_domain_exchange(sim->domain, part, (int)w, err);
+    for (size_t a = ni; st == SPH_OK && a < ne; ++a)
+      memcpy(coef + nc * a + j, part + w * a, w * sizeof *part);
+  }
+  const sph_neighbors *nl = ref->nl;
+  for (size_t a = 0; st == SPH_OK && a < ni; ++a)
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      size_t b = (size_t)nl->index[k];
+      double l;
+      if (b < ni)
+        continue;
+      sph_correction_slot(cloud, coef + nc * b, b, a, grad + 3 * rev[k], &l);
+      if (lap)
+        lap[rev[k]] = l;
+    }
+  free(coef);
+  free(part);
+  return st;
 }
 
 /* w_ab = V_b W'(r) / r per slot and s_a = sum_b w_ab r_ab */

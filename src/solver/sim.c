@@ -125,10 +125,16 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
   const sph_node *bcs = sph_node_child(s->root, "boundaries");
   if (!sim->method->distributed) {
     const sph_node *name = sph_node_child(s->method, "name");
+    char runs[256] = ""; /* the methods that do, from the registry */
+    for (const sph_method_ops *const *m = sph_method_list(); *m; ++m)
+      if ((*m)->distributed) {
+        strncat(runs, runs[0] ? ", " : "", sizeof runs - strlen(runs) - 1);
+        strncat(runs, (*m)->name, sizeof runs - strlen(runs) - 1);
+      }
     return sph_node_error(name ? name : s->method, err, SPH_ERR_UNSUPPORTED,
-                          "%s does not run over MPI ranks yet (tl-csph "
-                          "does); run it without mpirun",
-                          sim->method->name);
+                          "%s does not run over MPI ranks yet (these do: "
+                          "%s); run it without mpirun",
+                          sim->method->name, runs);
   }
   for (size_t k = 0; k < s->nboundaries; ++k)
     if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||

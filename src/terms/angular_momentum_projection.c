@@ -2,33 +2,38 @@
  * internal forces are corrected in the least-squares sense so that their
  * sum and their moment about the stage positions X^chi vanish on each body.
  * With Y = X - Xc (Xc the volume centroid) the system of eq. 48 decouples:
- * lambda = -I_Y^-1 sum V Y x T, mu = -sum V T / sum V. */
+ * lambda = -I_Y^-1 sum V Y x T, mu = -sum V T / sum V. Over MPI ranks the
+ * body's sums are global (sph_domain_sum, in rank order). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
-void sph_momentum_projection(size_t n, const double *V, const double *X,
-                             const int32_t *body, int nbodies, double *w) {
+void sph_momentum_projection(sph_domain *d, size_t n, const double *V,
+                             const double *X, const int32_t *body, int nbodies,
+                             double *w) {
   for (int b = 0; b < nbodies; ++b) {
     /* centroid, total force and volume of the body (serial: repeatable) */
-    double vol = 0.0, xc[3] = {0, 0, 0}, sum[3] = {0, 0, 0};
+    double s[7] = {0, 0, 0, 0, 0, 0, 0}; /* volume, V X, V w */
+    double *xc = s + 1, *sum = s + 4;
     for (size_t a = 0; a < n; ++a) {
       if (body[a] != b)
         continue;
-      vol += V[a];
+      s[0] += V[a];
       for (int c = 0; c < 3; ++c) {
         xc[c] += V[a] * X[3 * a + c];
         sum[c] += V[a] * w[3 * a + c];
       }
     }
+    sph_domain_sum(d, s, 7);
+    double vol = s[0];
     if (!(vol > 0.0))
       continue;
     for (int c = 0; c < 3; ++c)
       xc[c] /= vol;
     /* inertia about the centroid and moment of w */
-    double I[9] = {0}, m[3] = {0, 0, 0};
+    double Im[12] = {0}, *I = Im, *m = Im + 9;
     for (size_t a = 0; a < n; ++a) {
       if (body[a] != b)
         continue;
@@ -42,6 +47,7 @@ void sph_momentum_projection(size_t n, const double *V, const double *X,
       for (int c = 0; c < 3; ++c)
         m[c] += V[a] * t[c];
     }
+    sph_domain_sum(d, Im, 12);
     /* planar bodies have no inertia about in-plane axes: keep the z part */
     double Iinv[9], lambda[3] = {0, 0, 0};
     if (sph_mat3_inverse(I, Iinv) != 0.0) {
@@ -68,14 +74,16 @@ void sph_momentum_projection(size_t n, const double *V, const double *X,
 static sph_status projection_rates(sph_term *term, sph_sim *sim,
                                    sph_stage *stage, sph_error *err) {
   const sph_particles *ps = sim->ps;
-  sph_momentum_projection(ps->n, ps->field[SPH_FIELD_VOLUME0], stage->x_moment,
-                          ps->body, (int)sim->scene->nbodies, stage->dp);
+  sph_momentum_projection(sim->domain, ps->n, ps->field[SPH_FIELD_VOLUME0],
+                          stage->x_moment, ps->body, (int)sim->scene->nbodies,
+                          stage->dp);
   return SPH_OK;
 }
 
 static const sph_term_ops projection_ops = {
     .name = "angular_momentum_projection",
     .reference = "seed 000 sec. 6 eq. 45-48",
+    .distributed = 1,
     .rates = projection_rates,
 };
 

@@ -5,7 +5,10 @@
  * mean of Lap W~, the inner L[u] as eq. 27),
  * for u = p (into dp) or u = J (into dJ), never F or H (involutions). The
  * conservative projections of eq. 49 (p: zero sum and moment per body) and
- * eq. 51 (J: zero volume-weighted sum per body) are applied when asked. */
+ * eq. 51 (J: zero volume-weighted sum per body) are applied when asked.
+ * Over MPI ranks (sim->domain) the ghosts' u (when the method's sweep has
+ * not set it) and L[u] are exchanged before the sweeps that read them, and
+ * the projections' sums are global. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -73,8 +76,13 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   double cp = j->p.cp_now ? *j->p.cp_now : j->p.cp;
   double c2 = j->p.eps2 * cp * j->p.h;
   double c4 = j->p.eps4 * cp * j->p.h * j->p.h * j->p.h;
+  if (j->p.exchange_u)
+    SPH_TRY(sph_domain_exchange(sim->domain, (double *)u, nc, err));
   if (!j->p.lu)
     laplacian(j, j->p.lap, u, NULL, 0.0, 1.0, j->lu, n);
+  /* the second sweep reads the ghosts' L[u] */
+  if (j->p.lap_sym || c4 != 0.0)
+    SPH_TRY(sph_domain_exchange(sim->domain, j->lu, nc, err));
   if (sim->mirror) { /* the images' Laplacians mirror their sources' */
     if (nc == 3)
       sph_mirror_vector(sim->mirror, j->lu);
@@ -96,18 +104,19 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
   }
   if (j->p.project) {
     if (nc == 3) {
-      sph_momentum_projection(ps->n, ps->field[SPH_FIELD_VOLUME0],
+      sph_momentum_projection(sim->domain, ps->n, ps->field[SPH_FIELD_VOLUME0],
                               stage->x_moment, ps->body,
                               (int)sim->scene->nbodies, j->d);
     } else {
       for (size_t b = 0; b < sim->scene->nbodies; ++b) {
-        double sv = 0.0, sd = 0.0;
+        double s[2] = {0.0, 0.0}; /* sum V, sum V D */
         for (long a = 0; a < n; ++a)
           if (ps->body[a] == (int32_t)b) {
-            sv += V[a];
-            sd += V[a] * j->d[a];
+            s[0] += V[a];
+            s[1] += V[a] * j->d[a];
           }
-        double mu = sv > 0.0 ? -sd / sv : 0.0;
+        sph_domain_sum(sim->domain, s, 2);
+        double mu = s[0] > 0.0 ? -s[1] / s[0] : 0.0;
         for (long a = 0; a < n; ++a)
           if (ps->body[a] == (int32_t)b)
             j->d[a] += mu;
@@ -133,6 +142,7 @@ static void jst_destroy(sph_term *term) {
 static const sph_term_ops jst_p_ops = {
     .name = "jst_dissipation_p",
     .reference = "seed 000 eq. 35-38, projection eq. 49",
+    .distributed = 1,
     .rates = jst_rates,
     .destroy = jst_destroy,
 };
@@ -140,6 +150,7 @@ static const sph_term_ops jst_p_ops = {
 static const sph_term_ops jst_p_sym_ops = {
     .name = "jst_dissipation_p",
     .reference = "seed 004 eq. 27-28 (symmetrised)",
+    .distributed = 1,
     .rates = jst_rates,
     .destroy = jst_destroy,
 };
@@ -147,6 +158,7 @@ static const sph_term_ops jst_p_sym_ops = {
 static const sph_term_ops jst_j_ops = {
     .name = "jst_dissipation_J",
     .reference = "seed 000 eq. 35-38, projection eq. 51",
+    .distributed = 1,
     .rates = jst_rates,
     .destroy = jst_destroy,
 };

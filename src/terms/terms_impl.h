@@ -12,9 +12,11 @@
 /* Projects a per-particle vector field w (3 per particle, e.g. the internal
  * forces) so that sum V w = 0 and sum V X x w = 0 over each body, in the
  * least-squares sense of seed 000 eq. 46-48: w^ = w + lambda x (X - Xc) +
- * mu. */
-void sph_momentum_projection(size_t n, const double *V, const double *X,
-                             const int32_t *body, int nbodies, double *w);
+ * mu; over MPI ranks (d not NULL) the n particles are this rank's and the
+ * body's sums are global. */
+void sph_momentum_projection(sph_domain *d, size_t n, const double *V,
+                             const double *X, const int32_t *body, int nbodies,
+                             double *w);
 
 /* Angular momentum projection of the internal force (seed 000 eq. 45-48):
  * acts on stage->dp, so it must come before terms that add external or
@@ -42,6 +44,9 @@ typedef struct jst_params {
    * before the term runs, in this term's arithmetic (NULL: the term sums
    * it); the term fills the mirror images' entries */
   double *lu;
+  /* over MPI ranks: the ghosts' u are not set by the method's sweep, the
+   * term exchanges them (sph_domain_exchange) */
+  int exchange_u;
 } jst_params;
 sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
                                   sph_error *err);

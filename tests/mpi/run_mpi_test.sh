@@ -69,8 +69,9 @@ refused() { # name, sph args...
     return 1
   fi
 }
-expect="tl-jst does not run over MPI ranks yet"
-check "tl-jst refused" refused run twisting_column --quiet
+expect="ul-csph does not run over MPI ranks yet"
+check "ul-csph refused" refused run twisting_column --quiet \
+  --set 'method={name: ul-csph}'
 expect="symmetry planes"
 check "symmetry planes refused" refused run swinging_cube --quiet \
   --set 'method={name: tl-csph}'

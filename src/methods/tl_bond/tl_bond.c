@@ -14,7 +14,9 @@
  * M_a = I - sum_b (X_b - X_a) (x) q_ab, both fixed at set-up: a homogeneous
  * deformation x_b - x_a = F (X_b - X_a) gives F^c = F exactly. F itself is
  * integrated from eq. 24 and F^c is recomputed from it and the positions at
- * every stage (it does not replace F). */
+ * every stage (it does not replace F). Over MPI ranks (sph_domain) each
+ * stage exchanges the ghosts' x, p and P, and the ghosts' pair weights
+ * toward this rank's particles come from their owners' coefficients. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,25 +49,31 @@ static void bond_defgrad(tl_bond *m, long n) {
     tl_mirror_refresh(ref, m->x, m->p, m->Fc, NULL, NULL);
 }
 
-/* images from their sources, F^c (or F), P at it for every point */
-static const double *deformation_and_stress(tl_bond *m) {
+/* images from their sources, F^c (or F) into *Fs, P at it for every
+ * point; over MPI ranks the ghosts' x and p before, their P after (from
+ * their owners) */
+static sph_status deformation_and_stress(tl_bond *m, const double **Fs,
+                                         sph_error *err) {
   tl_reference *ref = &m->ref;
-  long n = (long)ref->n, ne = (long)ref->n_ext;
+  sph_domain *d = m->sim->domain;
+  long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  const double *Fs = m->F;
+  SPH_TRY(sph_domain_exchange(d, m->x, 3, err));
+  SPH_TRY(sph_domain_exchange(d, m->p, 3, err));
+  *Fs = m->F;
   if (m->bond) {
     bond_defgrad(m, n);
-    Fs = m->Fc;
+    *Fs = m->Fc;
   }
 #pragma omp parallel for schedule(static)
-  for (long a = 0; a < ne; ++a) {
+  for (long a = 0; a < ni; ++a) {
     double H[9];
-    const double *Fa = Fs + 9 * a;
+    const double *Fa = *Fs + 9 * a;
     sph_mat3_cofactor(Fa, H);
     sph_material_stress(ref->mat[a], Fa, H, sph_mat3_det(Fa), m->P + 9 * a);
   }
-  return Fs;
+  return sph_domain_exchange(d, m->P, 9, err);
 }
 
 /* ---- right-hand side
@@ -81,7 +89,8 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
   double t0 = sph_wtime();
   (void)stage;
   (void)dt;
-  deformation_and_stress(m);
+  const double *Fs;
+  SPH_TRY(deformation_and_stress(m, &Fs, err));
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a)
@@ -119,14 +128,17 @@ static double tl_bond_stable_dt(sph_sim *sim) {
   tl_bond *m = sim->method_data;
   const tl_reference *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
-  long n = (long)ref->n, ne = (long)ref->n_ext;
+  long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+  /* over MPI ranks the pairs read the ghosts' x and stretches */
+  if (sph_domain_exchange(sim->domain, m->x, 3, NULL) != SPH_OK)
+    return NAN;
   double lam_min = 1.0;
   if (m->pair_speed) {
     lam_min = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : lam_min)
-    for (long a = 0; a < ne; ++a) {
+    for (long a = 0; a < ni; ++a) {
       double Ft[9], C[9], lo, hi;
       sph_mat3_transpose(m->F + 9 * a, Ft);
       sph_mat3_mul(Ft, m->F + 9 * a, C);
@@ -134,6 +146,9 @@ static double tl_bond_stable_dt(sph_sim *sim) {
       m->lam[a] = sqrt(fmax(lo, 0.0));
       lam_min = fmin(lam_min, m->lam[a]);
     }
+    lam_min = sph_domain_min(sim->domain, lam_min);
+    if (sph_domain_exchange(sim->domain, m->lam, 1, NULL) != SPH_OK)
+      return NAN;
   }
   double tmin = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : tmin)
@@ -161,7 +176,8 @@ static sph_status tl_bond_step(sph_sim *sim, double dt, sph_error *err) {
 
 static sph_status tl_bond_derive(sph_sim *sim, sph_error *err) {
   tl_bond *m = sim->method_data;
-  const double *Fs = deformation_and_stress(m);
+  const double *Fs;
+  SPH_TRY(deformation_and_stress(m, &Fs, err));
   tl_derive(sim, &m->ref, NULL, NULL, Fs);
   return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
@@ -206,7 +222,9 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
   const tl_reference *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   size_t ne = ref->n_ext, count = nl->count;
-  sph_cloud cloud = {.n = ne,
+  /* over MPI ranks the ghosts' rows are not whole: their slots toward this
+   * rank's particles come from their owners' coefficients (tl_ghost_slots) */
+  sph_cloud cloud = {.n = ref->n_img,
                      .dim = sim->scene->dimension,
                      .x = ref->X,
                      .volume = ref->V,
@@ -226,9 +244,11 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
            NULL, err)) != SPH_OK ||
       (st = sph_correction_kernel(&cloud, first_order ? 1 : 0, w, wself,
                                   err)) != SPH_OK ||
-      (need_lap && (st = sph_correction_laplacian(&cloud, lap, err)) != SPH_OK))
+      (need_lap &&
+       (st = sph_correction_laplacian(&cloud, lap, err)) != SPH_OK) ||
+      (st = tl_ghost_slots(sim, ref, &cloud, rev, g, lap, err)) != SPH_OK)
     goto done;
-  for (size_t a = 0; a < ne; ++a) {
+  for (size_t a = 0; a < cloud.n; ++a) {
     double *M = m->Mc + 9 * a;
     sph_mat3_identity(M);
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
@@ -297,6 +317,11 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "pair", &ws, err));
   m->bond = dg == 0;
   m->pair_speed = ws == 0;
+  if (sim->domain && corr == 1)
+    return sph_node_error(sph_node_child(opt, "correction"), err,
+                          SPH_ERR_UNSUPPORTED,
+                          "correction: zeroth_order does not run over MPI "
+                          "ranks yet (first_order does); run without mpirun");
   m->integrate = integ == 0 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
   SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.9, &m->cfl, err));
   /* both integrators are SSP with coefficient 1: stable up to the forward
@@ -384,6 +409,7 @@ const sph_method_ops tl_bond_method_ops = {
     .reference = "seed 004 (Wiragunarsa et al.) eq. 6-14, 22, 24, 28, 30-32, "
                  "37-39",
     .conserves_angular_momentum = 0,
+    .distributed = 1,
     .fields = TL_OUTPUT_FIELDS,
     .setup = tl_bond_setup,
     .stable_dt = tl_bond_stable_dt,

@@ -5,7 +5,9 @@
  * on p and J only (eq. 35-38), angular momentum and JST projections
  * (eq. 45-51), monolithic TVD-RK2 (eq. 43; or the SSP-RK3 of seed 004
  * eq. 30) with dt from eq. 44, essential
- * boundary conditions imposed on particles. */
+ * boundary conditions imposed on particles. Over MPI ranks (sph_domain)
+ * every rate evaluation (each Runge-Kutta stage) exchanges the ghosts' p and
+ * Q = P L (or P) before the pair sweep. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -175,7 +177,14 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   refresh_images(m);
-  compute_stress(m, (long)m->ref.n_ext, 0);
+  /* over MPI ranks the sweep reads the ghosts' p and Q (or P), which their
+   * owners compute */
+  SPH_TRY(sph_domain_exchange(sim->domain, m->p, 3, err));
+  compute_stress(m, (long)m->ref.n_img, 0);
+  if (m->force == TL_JST_CONSERVATIVE)
+    SPH_TRY(sph_domain_exchange(sim->domain, m->ref.Qt, 9, err));
+  else
+    SPH_TRY(sph_domain_exchange(sim->domain, m->P, 9, err));
   m->sweep(m, n);
   /* X^chi of eq. 45: x^n, then x^n + dt / (2 rho0) (p^n + p*) for
    * TVD-RK2; SSP-RK3 takes the stage's x (no exact angular momentum) */
@@ -229,7 +238,7 @@ static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   tl_jst *m = sim->method_data;
   refresh_images(m);
-  compute_stress(m, (long)m->ref.n_ext, 1);
+  compute_stress(m, (long)m->ref.n_img, 1);
   tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
             m->fields == TL_JST_PF ? NULL : m->J, NULL);
   return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
@@ -361,7 +370,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   size_t ne = m->ref.n_ext;
   /* symmetry planes exert forces: the totals the projections zero are not
    * zero there */
-  if (ne > n && (amp || jproj))
+  if (m->ref.n_img > n && (amp || jproj))
     return sph_node_error(
         sph_node_child(opt,
                        amp ? "angular_momentum_projection" : "jst_projection"),
@@ -378,7 +387,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     for (size_t a = 0; a < ne; ++a)
       sph_mat3_cofactor(m->F + 9 * a, m->H + 9 * a);
   }
-  sph_cloud cloud = {.n = ne,
+  /* over MPI ranks the ghosts' rows are not used (nor complete) */
+  sph_cloud cloud = {.n = m->ref.n_img,
                      .dim = s->dimension,
                      .x = m->ref.X,
                      .volume = m->ref.V,
@@ -387,12 +397,19 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
              : m->force == TL_JST_EQ31       ? sweep_eq31
                                              : sweep_symmetric;
+  if (sim->domain && bc == 1)
+    return sph_node_error(sph_node_child(opt, "essential_bc"), err,
+                          SPH_ERR_UNSUPPORTED,
+                          "essential_bc: lagrange does not run over MPI ranks "
+                          "yet (essential_bc: direct does); run without "
+                          "mpirun");
   if (m->force == TL_JST_EQ31) {
     SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
     SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
     SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
                                     m->fgrad_self, NULL, err));
     SPH_TRY(tl_reference_reverse_slots(&m->ref, &m->rev, err));
+    SPH_TRY(tl_ghost_slots(sim, &m->ref, &cloud, m->rev, m->fgrad, NULL, err));
   }
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
@@ -402,7 +419,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     } else {
       /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
       const double *X = m->ref.X;
-      for (size_t a = 0; a < ne; ++a)
+      for (size_t a = 0; a < cloud.n; ++a)
         for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1];
              ++k) {
           size_t b = (size_t)m->ref.nl->index[k];
@@ -413,7 +430,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
         }
     }
     /* the JST term takes V_b Lap W~_b(X_a) */
-    for (size_t a = 0; a < ne; ++a)
+    for (size_t a = 0; a < cloud.n; ++a)
       for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k)
         m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
   }
@@ -462,7 +479,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .eps4 = e4j,
                      .cp = m->ref.cp,
                      .h = sim->dp,
-                     .project = jproj};
+                     .project = jproj,
+                     .exchange_u = 1};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
@@ -497,6 +515,7 @@ const sph_method_ops tl_jst_method_ops = {
     .reference = "seed 000 (Lee et al. 2016) sec. 3-7, Algorithm 1; seed 003 "
                  "eq. 11",
     .conserves_angular_momentum = 1,
+    .distributed = 1,
     .fields = TL_OUTPUT_FIELDS,
     .setup = tl_jst_setup,
     .stable_dt = tl_jst_stable_dt,
