@@ -70,13 +70,17 @@ typedef struct sph_state_array {
   size_t len;
 } sph_state_array;
 #define SPH_MAX_STATE 12
+#define SPH_DISTRIBUTED_DYNAMIC 2
 
 typedef struct sph_method_ops {
   const char *name;               /* scene name, e.g. "tl-jst" */
   const char *title;              /* readable name */
   const char *reference;          /* seed sections and equations */
   int conserves_angular_momentum; /* to round-off, for a free body */
-  int distributed;      /* runs over MPI ranks (sph_domain: owned + ghosts) */
+  /* runs over MPI ranks (sph_domain: owned + ghosts): 1 with the fixed
+   * reference neighbourhoods, SPH_DISTRIBUTED_DYNAMIC with the ghosts found
+   * again, migration and re-balancing at its rebuilds (updated Lagrangian) */
+  int distributed;
   unsigned long fields; /* the output fields it fills: bit 1ul << f */
   /* validates the method block, requires fields, creates its terms */
   sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);

@@ -127,7 +127,7 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     const sph_node *name = sph_node_child(s->method, "name");
     return sph_node_error(name ? name : s->method, err, SPH_ERR_UNSUPPORTED,
                           "%s does not run over MPI ranks yet (tl-csph "
-                          "does); run it without mpirun",
+                          "and ul-sph do); run it without mpirun",
                           sim->method->name);
   }
   for (size_t k = 0; k < s->nboundaries; ++k)
@@ -148,7 +148,17 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                           "drop output.checkpoint_every or run without "
                           "mpirun");
   }
-  return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
+  if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
+    return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
+  /* the boundary conditions' particle sets do not follow migrations yet */
+  if (sph_scene_has_essential_bc(s))
+    return sph_node_error(bcs ? bcs : s->root, err, SPH_ERR_UNSUPPORTED,
+                          "%s with boundary conditions (clamps, rollers, "
+                          "prescribed velocities) does not run over MPI "
+                          "ranks yet; run without mpirun",
+                          sim->method->name);
+  return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,
+                                   err);
 }
 
 /* Every term a distributed method creates must run on owned particles. */

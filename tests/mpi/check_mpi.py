@@ -6,7 +6,7 @@ PolyData reader) lists RANKS pieces that read without a VTK error or warning
 and together hold the serial particle count and arrays; every value equals
 the serial one (matched by particle_id) within REL_TOL of the array's
 largest magnitude; the PNG frames (rank 0, from the gathered particles)
-and probes.csv equal the serial files; energy.csv has the
+and probes.csv (when the scene has probes) equal the serial files; energy.csv has the
 serial rows, the momenta equal and the energies within REL_TOL (sums over
 ranks in another order). Prints the largest relative difference measured.
 Usage: check_mpi.py SERIAL_DIR MPI_DIR SCENE RANKS REL_TOL"""
@@ -105,10 +105,15 @@ def main():
                 open(os.path.join(par, "frames", f), "rb") as b:
             if a.read() != b.read():
                 fail("frames/%s differs from the serial run's" % f)
-    with open(os.path.join(serial, "probes.csv")) as a, \
-            open(os.path.join(par, "probes.csv")) as b:
-        if a.read() != b.read():
-            fail("probes.csv differs from the serial run's")
+    probes = [os.path.exists(os.path.join(d, "probes.csv"))
+              for d in (serial, par)]
+    if probes[0] != probes[1]:
+        fail("probes.csv written by one run only")
+    if probes[0]:
+        with open(os.path.join(serial, "probes.csv")) as a, \
+                open(os.path.join(par, "probes.csv")) as b:
+            if a.read() != b.read():
+                fail("probes.csv differs from the serial run's")
     with open(os.path.join(serial, "energy.csv")) as a, \
             open(os.path.join(par, "energy.csv")) as b:
         ra, rb = list(csv.reader(a)), list(csv.reader(b))

@@ -53,7 +53,7 @@ static double max_speed(const ul_sph *m) {
     double s = sph_vec3_dot(m->v + 3 * a, m->v + 3 * a);
     vmax2 = s > vmax2 ? s : vmax2;
   }
-  return sqrt(vmax2);
+  return sqrt(sph_domain_max(m->sim->domain, vmax2)); /* over the ranks */
 }
 
 /* neighbours of `pos` and their pair geometry, without touching the time */
@@ -62,8 +62,16 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
   sph_sim *sim = m->sim;
   double t0 = sph_wtime();
   const sph_kernel *k = &sim->kernel;
-  SPH_TRY(sph_neighbors_build(m->nl, pos, m->n, sim->scene->dimension,
+  /* over MPI ranks: migration, re-balance, the ghosts of this rebuild */
+  if (sim->domain && pos == m->x) {
+    SPH_TRY(sph_domain_rebuild(sim->domain, sim->ps, k->support, err));
+    m->n = sim->ps->n;
+    m->ng = sph_domain_ghosts(sim->domain);
+  }
+  SPH_TRY(sph_neighbors_build(m->nl, pos, m->n + m->ng, sim->scene->dimension,
                               k->support, NULL, SPH_PAIRS_ALL, err));
+  /* a distributed run sums pairs in the serial run's order */
+  sph_domain_sort_lists(sim->domain, m->nl, m->n);
   size_t count = m->nl->count;
   if (count > m->slot_cap) { /* grow-only, with room for later updates */
     size_t cap = count + count / 2 + 16;
@@ -118,7 +126,7 @@ static sph_status configuration_update(ul_sph *m, double t, sph_error *err) {
 /* total stress of the artificial stress: R = -eps sigma'/rho^2 on the
  * positive principal stresses, rotated back */
 static void artificial_stress(ul_sph *m) {
-  long n = (long)m->n;
+  long n = (long)(m->n + m->ng);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double S[9], w[3], Q[9], R[9] = {0};
@@ -137,9 +145,9 @@ static void artificial_stress(ul_sph *m) {
   }
 }
 
-/* current volumes m / rho */
+/* current volumes m / rho (ghosts' too) */
 static void volumes(ul_sph *m) {
-  long n = (long)m->n;
+  long n = (long)(m->n + m->ng);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a)
     m->vol[a] = m->m[a] / m->rho[a];
@@ -297,22 +305,33 @@ static ul_sph_loops loops_of(ul_shear shear, int dim, int stress) {
 
 /* the acceleration of the state (pressure at rho, shear), into acc and the
  * shear part into accs */
-static void accelerations(ul_sph *m, double *acc, double *accs) {
+static sph_status accelerations(ul_sph *m, double *acc, double *accs,
+                                sph_error *err) {
   double tp = sph_wtime();
+  if (m->sim->domain) { /* the ghosts' state this pass reads */
+    double *f[] = {m->v, m->rho, m->p, m->sigma};
+    int nc[] = {3, 1, 1, 9};
+    SPH_TRY(sph_domain_exchange_many(
+        m->sim->domain, f, nc, m->shear == UL_SHEAR_LAPLACIAN ? 3 : 4, err));
+  }
   volumes(m);
   if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
     artificial_stress(m);
   m->loops.accelerations(m, acc, accs);
   m->sim->timers[m->timer_pressure].seconds += sph_wtime() - tp;
   m->sim->timers[m->timer_pressure].calls++;
+  return SPH_OK;
 }
 
-static void continuity_and_shear(ul_sph *m, double dt) {
+static sph_status continuity_and_shear(ul_sph *m, double dt, sph_error *err) {
   double tp = sph_wtime();
+  /* the ghosts' new velocities (their density is the pressure pass's) */
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->v, 3, err));
   volumes(m);
   m->loops.continuity(m, dt);
   m->sim->timers[m->timer_shear].seconds += sph_wtime() - tp;
   m->sim->timers[m->timer_shear].calls++;
+  return SPH_OK;
 }
 
 /* ---- method ops -------------------------------------------------------- */
@@ -331,7 +350,7 @@ static double ul_sph_stable_dt(sph_sim *sim) {
 static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
   ul_sph *m = sim->method_data;
   long n = (long)m->n;
-  double *accs = m->acc + 3 * m->n;
+  double *accs = m->acc + 3 * m->cap;
   double t0 = sph_wtime(), ti; /* the integration's own loops, timed */
   /* eq. 27: half a step of position and density, pressure from eq. 4 */
 #pragma omp parallel for schedule(static)
@@ -342,7 +361,7 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
     m->p[a] = m->c0[a] * m->c0[a] * (m->rho[a] - m->rho0[a]);
   }
   ti = sph_wtime() - t0;
-  accelerations(m, m->acc, accs);
+  SPH_TRY(accelerations(m, m->acc, accs, err));
   sph_stage st = {.t = sim->t + 0.5 * dt, .x = m->x, .p = m->v, .dp = m->acc};
   SPH_TRY(sph_sim_terms_rates(sim, &st, err));
   /* eq. 28, and the work done against the shear force */
@@ -367,7 +386,7 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
     for (int c = 0; c < 3; ++c)
       m->x[3 * a + c] += 0.5 * dt * m->v[3 * a + c];
   ti += sph_wtime() - t0;
-  continuity_and_shear(m, dt);
+  SPH_TRY(continuity_and_shear(m, dt, err));
   t0 = sph_wtime();
   long bad = n; /* the first particle with a non-finite or non-positive state */
 #pragma omp parallel for schedule(static) reduction(min : bad)
@@ -431,7 +450,7 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
     }
   }
   if (acc) { /* the acceleration of this state, terms included */
-    accelerations(m, acc, m->acc + 3 * m->n);
+    SPH_TRY(accelerations(m, acc, m->acc + 3 * m->cap, err));
     sph_stage st = {.t = sim->t, .x = m->x, .p = m->v, .dp = acc};
     SPH_TRY(sph_sim_terms_rates(sim, &st, err));
   }
@@ -563,6 +582,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sim = sim;
   sph_particles *ps = sim->ps;
   size_t n = m->n = ps->n;
+  size_t cap = m->cap = sph_domain_capacity(sim->domain, ps);
 
   /* options */
   static const char *const shears[] = {"original", "artificial-stress",
@@ -645,25 +665,34 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->v = ps->field[SPH_FIELD_VELOCITY];
   m->rho = ps->field[SPH_FIELD_DENSITY];
   double *rho0, *c0, *G;
-  SPH_TRY(alloc(&m->drho, n, err));
-  SPH_TRY(alloc(&m->p, n, err));
-  SPH_TRY(alloc(&m->m, n, err));
-  SPH_TRY(alloc(&rho0, n, err));
+  SPH_TRY(alloc(&m->drho, cap, err));
+  SPH_TRY(alloc(&m->p, cap, err));
+  SPH_TRY(alloc(&m->m, cap, err));
+  SPH_TRY(alloc(&rho0, cap, err));
   m->rho0 = rho0;
-  SPH_TRY(alloc(&c0, n, err));
+  SPH_TRY(alloc(&c0, cap, err));
   m->c0 = c0;
-  SPH_TRY(alloc(&G, n, err));
+  SPH_TRY(alloc(&G, cap, err));
   m->G = G;
-  SPH_TRY(alloc(&m->acc, 6 * n, err));
-  SPH_TRY(alloc(&m->work, n, err));
-  SPH_TRY(alloc(&m->vol, n, err));
-  SPH_TRY(alloc(&m->xcfg, 3 * n, err));
+  SPH_TRY(alloc(&m->acc, 6 * cap, err));
+  SPH_TRY(alloc(&m->work, cap, err));
+  SPH_TRY(alloc(&m->vol, cap, err));
+  SPH_TRY(alloc(&m->xcfg, 3 * cap, err));
   if (m->shear == UL_SHEAR_LAPLACIAN)
-    SPH_TRY(alloc(&m->acc_shear, 3 * n, err));
+    SPH_TRY(alloc(&m->acc_shear, 3 * cap, err));
   if (m->stress)
-    SPH_TRY(alloc(&m->sigma, 9 * n, err));
+    SPH_TRY(alloc(&m->sigma, 9 * cap, err));
   if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
-    SPH_TRY(alloc(&m->R, 9 * n, err));
+    SPH_TRY(alloc(&m->R, 9 * cap, err));
+  /* over MPI ranks: the state that moves with a particle (the particle
+   * set's fields move anyway; acc, vol, R and xcfg are remade) */
+  double *moving[] = {m->drho, m->p, m->m, rho0, c0, G, m->work};
+  for (size_t i = 0; i < sizeof moving / sizeof *moving; ++i)
+    SPH_TRY(sph_domain_track(sim->domain, moving[i], 1, err));
+  if (m->acc_shear)
+    SPH_TRY(sph_domain_track(sim->domain, m->acc_shear, 3, err));
+  if (m->sigma)
+    SPH_TRY(sph_domain_track(sim->domain, m->sigma, 9, err));
   const double *X = ps->field[SPH_FIELD_POSITION0];
   const double *V0 = ps->field[SPH_FIELD_VOLUME0];
   for (size_t a = 0; a < n; ++a) {
@@ -678,6 +707,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     ps->field[SPH_FIELD_MASS][a] = m->m[a];
     memcpy(m->x + 3 * a, X + 3 * a, 3 * sizeof *X);
   }
+  m->c0_max = sph_domain_max(sim->domain, m->c0_max);
   m->timer_config = sph_sim_add_timer(sim, "configuration");
   m->timer_pressure = sph_sim_add_timer(sim, "pressure_and_shear_force");
   m->timer_shear = sph_sim_add_timer(sim, "continuity_and_shear_rate");
@@ -699,6 +729,7 @@ const sph_method_ops ul_sph_method_ops = {
              "essentially non-hourglass)",
     .reference = "seed 002 (Zhang et al. 2024) eq. 4-18, 23-31",
     .conserves_angular_momentum = 0, /* seed 002 sec. 6.10 */
+    .distributed = SPH_DISTRIBUTED_DYNAMIC,
     .fields = 1ul << SPH_FIELD_POSITION0 | 1ul << SPH_FIELD_POSITION |
               1ul << SPH_FIELD_VELOCITY | 1ul << SPH_FIELD_ACCELERATION |
               1ul << SPH_FIELD_VOLUME0 | 1ul << SPH_FIELD_MASS |
