@@ -53,6 +53,9 @@ typedef struct sph_term_ops {
                           sph_error *err);
   /* the largest step the term's own rates allow (may be NULL: no bound) */
   double (*stable_dt)(sph_term *term, const sph_sim *sim);
+  /* the owned particles changed (a migration over MPI ranks): remakes the
+   * term's particle indices (may be NULL: it keeps none) */
+  sph_status (*renumber)(sph_term *term, sph_sim *sim, sph_error *err);
   void (*destroy)(sph_term *term);
 } sph_term_ops;
 
@@ -159,6 +162,8 @@ int sph_sim_add_timer(sph_sim *sim, const char *name);
 
 /* Runs every term's rates / constrain hook in order, timing each. */
 sph_status sph_sim_terms_rates(sph_sim *sim, sph_stage *stage, sph_error *err);
+/* every term's renumber hook, after a migration */
+sph_status sph_sim_terms_renumber(sph_sim *sim, sph_error *err);
 sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
                                    sph_error *err);
 

@@ -150,13 +150,6 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
   }
   if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
     return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
-  /* the boundary conditions' particle sets do not follow migrations yet */
-  if (sph_scene_has_essential_bc(s))
-    return sph_node_error(bcs ? bcs : s->root, err, SPH_ERR_UNSUPPORTED,
-                          "%s with boundary conditions (clamps, rollers, "
-                          "prescribed velocities) does not run over MPI "
-                          "ranks yet; run without mpirun",
-                          sim->method->name);
   return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,
                                    err);
 }

@@ -6,8 +6,8 @@ PolyData reader) lists RANKS pieces that read without a VTK error or warning
 and together hold the serial particle count and arrays; every value equals
 the serial one (matched by particle_id) within REL_TOL of the array's
 largest magnitude; the PNG frames (rank 0, from the gathered particles)
-and probes.csv (when the scene has probes) equal the serial files; energy.csv has the
-serial rows, the momenta equal and the energies within REL_TOL (sums over
+and probes.csv (when the scene has them) equal the serial files; energy.csv
+has the serial rows, the momenta equal and the energies within REL_TOL (sums over
 ranks in another order). Prints the largest relative difference measured.
 Usage: check_mpi.py SERIAL_DIR MPI_DIR SCENE RANKS REL_TOL"""
 import csv
@@ -96,10 +96,11 @@ def main():
             if d > tol:
                 fail("%s at t = %g: %s differs from serial by %g (relative)"
                      % (pf, t, name, d))
-    frames = sorted(os.listdir(os.path.join(serial, "frames")))
-    if not frames or frames != sorted(os.listdir(os.path.join(par, "frames"))):
-        fail("frames/ holds %s, serial %s" % (
-            sorted(os.listdir(os.path.join(par, "frames"))), frames))
+    frames, pframes = (sorted(os.listdir(os.path.join(d, "frames")))
+                       if os.path.isdir(os.path.join(d, "frames")) else []
+                       for d in (serial, par))
+    if frames != pframes:
+        fail("frames/ holds %s, serial %s" % (pframes, frames))
     for f in frames:
         with open(os.path.join(serial, "frames", f), "rb") as a, \
                 open(os.path.join(par, "frames", f), "rb") as b:

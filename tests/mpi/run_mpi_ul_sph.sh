@@ -6,8 +6,8 @@
 # identical, energies to 1e-12 relative: sums over ranks in another order);
 # the 3-rank cut crosses the left ring, so particles migrate and the ranks
 # re-balance (summary.json counts them); the same rank count twice writes
-# the same bytes; ul-sph with boundary conditions is refused with exit 2
-# before anything is written. Usage: run_mpi_ul_sph.sh SPH SOURCE_DIR
+# the same bytes; the stretched plate with its clamped base on 2 and 4 ranks
+# equals its serial run too. Usage: run_mpi_ul_sph.sh SPH SOURCE_DIR
 set -u
 sph=$1
 src=$2
@@ -61,21 +61,23 @@ same_bytes() {
 }
 check "np 3 twice: identical files" same_bytes
 
-# boundary conditions do not follow migrations yet: refused on every rank
-refused() {
-  local out=$work/refused
-  "${mpi[@]}" -np 2 "$sph" run tensile_plate_2d --quiet --out "$out" \
-    >"$work/ref.txt" 2>&1
-  local rc=$?
-  if [ $rc -ne 2 ] || [ -e "$out" ] ||
-    ! grep -q "ul-sph with boundary conditions" "$work/ref.txt"; then
-    echo "rc $rc, wanted 2"
-    cat "$work/ref.txt"
-    return 1
-  fi
-}
-check "ul-sph with boundary conditions refused" refused
+# a clamped base whose particles migrate (the boundary's particle sets
+# follow them): the stretched plate on 2 and 4 ranks
+plate=(run tensile_plate_2d --quiet --set output.every=0.001
+  --set 'output.fields=[velocity,displacement,pressure,von_mises,particle_id]')
+OMP_NUM_THREADS=1 "$sph" "${plate[@]}" --out "$work/plate" >/dev/null ||
+  { echo "FAIL serial plate"; exit 1; }
+for n in 2 4; do
+  check "plate np $n runs" "${mpi[@]}" -np $n "$sph" "${plate[@]}" \
+    --out "$work/plate$n"
+  check "plate np $n equals serial" /usr/bin/python3 \
+    "$src/tests/mpi/check_mpi.py" "$work/plate" "$work/plate$n" \
+    tensile_plate_2d $n 1e-12
+  cat "$work/out.txt"
+done
+plate_moved() { grep -Eq '"migrated": [1-9]' "$work/plate4/summary.json"; }
+check "plate np 4 migrates" plate_moved
 
-total=10
+total=14
 echo "$((total - fails)) passed, $fails failed"
 [ $fails -eq 0 ]

@@ -67,6 +67,7 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
     SPH_TRY(sph_domain_rebuild(sim->domain, sim->ps, k->support, err));
     m->n = sim->ps->n;
     m->ng = sph_domain_ghosts(sim->domain);
+    SPH_TRY(sph_sim_terms_renumber(sim, err));
   }
   SPH_TRY(sph_neighbors_build(m->nl, pos, m->n + m->ng, sim->scene->dimension,
                               k->support, NULL, SPH_PAIRS_ALL, err));
