@@ -121,10 +121,11 @@ sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
 sph_status sph_domain_exchange_many(sph_domain *d, double *const *fields,
                                     const int *ncomp, int count,
                                     sph_error *err);
-/* Over the run and all ranks: particles migrated, re-balances, rebuilds
- * (zeros for a fixed domain). */
+/* Over the run and all ranks: particles migrated, re-balances, rebuilds,
+ * the largest halo (particles sent per exchange, all ranks) and the most
+ * ghosts a rank held (zeros for a fixed domain). */
 typedef struct sph_domain_moves {
-  double migrated, rebalances, rebuilds;
+  double migrated, rebalances, rebuilds, halo_max, ghosts_max;
 } sph_domain_moves;
 sph_domain_moves sph_domain_moves_of(const sph_domain *d);
 

@@ -103,8 +103,10 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   if (mv.rebuilds > 0.0) /* updated Lagrangian: over the run, all ranks */
     fprintf(f,
             "  \"halo_rebuilds\": %.0f,\n  \"migrated\": %.0f,\n"
-            "  \"rebalances\": %.0f,\n",
-            mv.rebuilds, mv.migrated, mv.rebalances);
+            "  \"rebalances\": %.0f,\n  \"ghosts_max\": %.0f,\n"
+            "  \"halo_max\": %.0f,\n",
+            mv.rebuilds, mv.migrated, mv.rebalances, mv.ghosts_max,
+            mv.halo_max);
   fputs("  \"wall_seconds\": ", f);
   json_number(f, wall_seconds);
   fputs(",\n  \"dt_min\": ", f);

@@ -42,6 +42,7 @@ struct sph_domain_dyn {
   rcb_key *keys; /* re-balance: N */
   int *owner;    /* re-balance: N, by storage index */
   double migrated, rebalances, rebuilds;
+  double halo_max, ghosts_max; /* the largest halo and ghost layer */
 };
 
 size_t sph_domain_dyn_capacity(size_t N, int R) {
@@ -93,10 +94,11 @@ sph_status sph_domain_track(sph_domain *d, double *array, int ncomp,
 }
 
 sph_domain_moves sph_domain_moves_of(const sph_domain *d) {
-  sph_domain_moves m = {0.0, 0.0, 0.0};
+  sph_domain_moves m = {0.0, 0.0, 0.0, 0.0, 0.0};
   if (d && d->dyn)
     m = (sph_domain_moves){d->dyn->migrated, d->dyn->rebalances,
-                           d->dyn->rebuilds};
+                           d->dyn->rebuilds, d->dyn->halo_max,
+                           d->dyn->ghosts_max};
   return m;
 }
 
@@ -423,6 +425,10 @@ sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
   SPH_TRY(migrate(d, ps, err));
   SPH_TRY(find_ghosts(d, ps, radius, err));
   y->rebuilds += 1.0;
+  double halo = (double)d->nsend;
+  sph_domain_sum(d, &halo, 1);
+  y->halo_max = fmax(y->halo_max, halo);
+  y->ghosts_max = fmax(y->ghosts_max, sph_domain_max(d, (double)d->ng));
   d->seconds += MPI_Wtime() - t0;
   return SPH_OK;
 }

@@ -11,22 +11,8 @@
 set -u
 sph=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-check() { # name, command...
-  local name=$1
-  shift
-  if "$@" >"$work/out.txt" 2>&1; then
-    echo "ok   $name"
-  else
-    echo "FAIL $name"
-    tail -20 "$work/out.txt"
-    fails=$((fails + 1))
-  fi
-}
-mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
-[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+# shellcheck source=mpi_common.sh
+. "$src/tests/mpi/mpi_common.sh"
 run=(run colliding_rings --quiet --set time.end=0.004
   --set output.every=0.001 --set output.png.width=320
   --set output.png.height=180 --set output.png.mp4=false
@@ -52,14 +38,7 @@ cat "$work/out.txt"
 
 # the same rank count and thread count: the same bytes
 check "np 3 again" "${mpi[@]}" -np 3 "$sph" "${run[@]}" --out "$work/np3b"
-same_bytes() {
-  for f in "$work/np3"/* "$work/np3"/frames/*; do
-    b=${f#"$work/np3/"}
-    case $b in summary.json | scene_used.yaml | frames) continue ;; esac
-    cmp -s "$f" "$work/np3b/$b" || { echo "$b differs"; return 1; }
-  done
-}
-check "np 3 twice: identical files" same_bytes
+check "np 3 twice: identical files" same_bytes "$work/np3" "$work/np3b"
 
 # a clamped base whose particles migrate (the boundary's particle sets
 # follow them): the stretched plate on 2 and 4 ranks

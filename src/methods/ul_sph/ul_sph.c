@@ -45,7 +45,8 @@
 
 /* ---- configuration --------------------------------------------------- */
 
-static double max_speed(const ul_sph *m) {
+/* this rank's largest speed (the serial run's with `global` over ranks) */
+static double max_speed(const ul_sph *m, int global) {
   double vmax2 = 0.0;
   long n = (long)m->n;
 #pragma omp parallel for schedule(static) reduction(max : vmax2)
@@ -53,7 +54,7 @@ static double max_speed(const ul_sph *m) {
     double s = sph_vec3_dot(m->v + 3 * a, m->v + 3 * a);
     vmax2 = s > vmax2 ? s : vmax2;
   }
-  return sqrt(sph_domain_max(m->sim->domain, vmax2)); /* over the ranks */
+  return sqrt(global ? sph_domain_max(m->sim->domain, vmax2) : vmax2);
 }
 
 /* neighbours of `pos` and their pair geometry, without touching the time */
@@ -115,7 +116,7 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
  * with single-criterion stepping) */
 static sph_status configuration_update(ul_sph *m, double t, sph_error *err) {
   SPH_TRY(configuration_build(m, m->x, err));
-  double vmax = max_speed(m);
+  double vmax = max_speed(m, 1);
   double dt_ad = vmax > 0.0 ? m->cfl_ad * m->sim->kernel.h / vmax : INFINITY;
   m->config[0] = m->dual ? t + dt_ad : t;
   m->config[1] += 1.0;
@@ -340,7 +341,8 @@ static sph_status continuity_and_shear(ul_sph *m, double dt, sph_error *err) {
 static double ul_sph_stable_dt(sph_sim *sim) {
   ul_sph *m = sim->method_data;
   /* eq. 26 */
-  double dt = m->cfl_ac * sim->kernel.h / (m->c0_max + max_speed(m));
+  /* a rank's own speed: the smallest step over the ranks is the serial one */
+  double dt = m->cfl_ac * sim->kernel.h / (m->c0_max + max_speed(m, 0));
   /* the rest of the advection step in equal acoustic steps */
   double rest = m->config[0] - sim->t;
   if (m->dual && rest > 0.0 && rest < INFINITY)
@@ -685,8 +687,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     SPH_TRY(alloc(&m->sigma, 9 * cap, err));
   if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
     SPH_TRY(alloc(&m->R, 9 * cap, err));
-  /* over MPI ranks: the state that moves with a particle (the particle
-   * set's fields move anyway; acc, vol, R and xcfg are remade) */
+  /* over MPI ranks: what moves with a particle besides the set's fields */
   double *moving[] = {m->drho, m->p, m->m, rho0, c0, G, m->work};
   for (size_t i = 0; i < sizeof moving / sizeof *moving; ++i)
     SPH_TRY(sph_domain_track(sim->domain, moving[i], 1, err));
