@@ -115,7 +115,9 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
 /* eq. 25: the next update is one advection step away (every acoustic step
  * with single-criterion stepping) */
 static sph_status configuration_update(ul_sph *m, double t, sph_error *err) {
-  SPH_TRY(configuration_build(m, m->x, err));
+  sph_status st = configuration_build(m, m->x, err);
+  /* over MPI ranks every rank learns of a failure before the next all-reduce */
+  SPH_TRY(sph_domain_agree(m->sim->domain, st, err));
   double vmax = max_speed(m, 1);
   double dt_ad = vmax > 0.0 ? m->cfl_ad * m->sim->kernel.h / vmax : INFINITY;
   m->config[0] = m->dual ? t + dt_ad : t;
@@ -399,20 +401,27 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
         !isfinite(m->v[3 * a + 1]) || !isfinite(m->v[3 * a + 2]))
       bad = a < bad ? a : bad;
   }
+  sph_status fin = SPH_OK;
   if (bad < n)
-    return sph_error_set(err, SPH_ERR_NUMERIC,
-                         isfinite(m->rho[bad]) && isfinite(m->v[3 * bad]) &&
-                                 isfinite(m->v[3 * bad + 1]) &&
-                                 isfinite(m->v[3 * bad + 2])
-                             ? "particle %ld: density %g"
-                             : "particle %ld: non-finite state (density %g)",
-                         bad, m->rho[bad]);
+    fin = sph_error_set(err, SPH_ERR_NUMERIC,
+                        isfinite(m->rho[bad]) && isfinite(m->v[3 * bad]) &&
+                                isfinite(m->v[3 * bad + 1]) &&
+                                isfinite(m->v[3 * bad + 2])
+                            ? "particle %ld: density %g"
+                            : "particle %ld: non-finite state (density %g)",
+                        bad, m->rho[bad]);
+  double t1 = sim->t + dt;
+  /* (an output time may leave a sliver of the advection step: skip it) */
+  int update = !m->dual || t1 >= m->config[0] - 0.1 * dt;
+  /* the update is collective over MPI ranks: none may skip it alone */
+  if (update)
+    fin = sph_domain_agree(sim->domain, fin, err);
+  if (fin != SPH_OK)
+    return fin;
   sph_timer *tm = &sim->timers[m->timer_integration];
   tm->seconds += ti + sph_wtime() - t0;
   tm->calls++;
-  double t1 = sim->t + dt;
-  /* (an output time may leave a sliver of the advection step: skip it) */
-  if (!m->dual || t1 >= m->config[0] - 0.1 * dt)
+  if (update)
     SPH_TRY(configuration_update(m, t1, err));
   return SPH_OK;
 }
