@@ -2,7 +2,8 @@
  * bisection of the reference positions balanced by count, ghost layers of
  * one kernel support found with the cell-list search, a fixed halo exchange
  * with MPI_Irecv/MPI_Isend, reductions in rank order and the gather of the
- * output fields to rank 0. Every MPI call of sph is in this file. */
+ * output fields to rank 0. Every MPI call of sph is in this file and
+ * domain_dynamic.c (the updated-Lagrangian rebuild). */
 #include "sph/domain.h"
 #include "parallel/domain_impl.h"
 
@@ -301,7 +302,7 @@ static sph_status exchange_plan(sph_domain *d, const int *owner,
 
 /* rank 0 learns every rank's owned storage indices (the gather's map) */
 static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
-  int R = d->size, n = (int)d->n;
+  int R = d->size;
   int fail = 0;
   if (d->rank == 0) {
     d->all_count = malloc((size_t)R * sizeof(int));
@@ -315,7 +316,6 @@ static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
   }
   sph_status st = fail ? sph_error_set(err, SPH_ERR_NOMEM, "gather") : SPH_OK;
   SPH_TRY(sph_domain_agree(d, st, err));
-  (void)n;
   sph_domain_gather_map(d);
   return SPH_OK;
 }
