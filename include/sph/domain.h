@@ -89,4 +89,44 @@ sph_particles *sph_domain_global(const sph_domain *d);
 sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
                              sph_error *err);
 
+/* ---- updated-Lagrangian runs (src/parallel/domain_dynamic.c) ----------
+ * Their neighbourhoods change, so a dynamic domain is partitioned like the
+ * fixed one but finds its ghosts at every rebuild of the method's
+ * neighbour lists: particles that left the rank's RCB region move to their
+ * owner (migration), the ranks are cut again by RCB of the current
+ * positions when the most loaded owns more than SPH_DOMAIN_IMBALANCE over
+ * the mean (re-balance), and the ghosts are the other ranks' particles in
+ * the rank's box of owned particles widened by the search radius. Every
+ * per-particle array of the local set is sized at set-up for
+ * sph_domain_capacity particles (owned + ghosts); a rank that would
+ * outgrow it fails with SPH_ERR_RANGE, nothing grows in a step. */
+#define SPH_DOMAIN_IMBALANCE 0.10
+
+sph_status sph_domain_create_dynamic(sph_domain **out, sph_particles **ps,
+                                     double support, sph_error *err);
+/* Particles every per-particle array must hold (ps->n without a domain). */
+size_t sph_domain_capacity(const sph_domain *d, const sph_particles *ps);
+/* A method's own per-particle array (ncomp doubles a particle, capacity
+ * long) that moves with its particle and is copied to ghosts; the fields
+ * of the particle set, its ids, bodies and flags always do. */
+sph_status sph_domain_track(sph_domain *d, double *array, int ncomp,
+                            sph_error *err);
+/* The rebuild (collective): migration, re-balance when due, ghosts of the
+ * positions field within `radius`. On return ps->n is the owned count and
+ * the ghosts' values follow it in every field and tracked array. */
+sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
+                              sph_error *err);
+/* Sets the ghosts' values of `count` arrays (ncomp[i] doubles a particle,
+ * at most 32 doubles in all) in one message per neighbour rank. */
+sph_status sph_domain_exchange_many(sph_domain *d, double *const *fields,
+                                    const int *ncomp, int count,
+                                    sph_error *err);
+/* Over the run and all ranks: particles migrated, re-balances, rebuilds,
+ * the largest halo (particles sent per exchange, all ranks) and the most
+ * ghosts a rank held (zeros for a fixed domain). */
+typedef struct sph_domain_moves {
+  double migrated, rebalances, rebuilds, halo_max, ghosts_max;
+} sph_domain_moves;
+sph_domain_moves sph_domain_moves_of(const sph_domain *d);
+
 #endif

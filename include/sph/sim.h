@@ -53,6 +53,9 @@ typedef struct sph_term_ops {
                           sph_error *err);
   /* the largest step the term's own rates allow (may be NULL: no bound) */
   double (*stable_dt)(sph_term *term, const sph_sim *sim);
+  /* the owned particles changed (a migration over MPI ranks): remakes the
+   * term's particle indices (may be NULL: it keeps none) */
+  sph_status (*renumber)(sph_term *term, sph_sim *sim, sph_error *err);
   void (*destroy)(sph_term *term);
 } sph_term_ops;
 
@@ -70,13 +73,17 @@ typedef struct sph_state_array {
   size_t len;
 } sph_state_array;
 #define SPH_MAX_STATE 12
+#define SPH_DISTRIBUTED_DYNAMIC 2
 
 typedef struct sph_method_ops {
   const char *name;               /* scene name, e.g. "tl-jst" */
   const char *title;              /* readable name */
   const char *reference;          /* seed sections and equations */
   int conserves_angular_momentum; /* to round-off, for a free body */
-  int distributed;      /* runs over MPI ranks (sph_domain: owned + ghosts) */
+  /* runs over MPI ranks (sph_domain: owned + ghosts): 1 with the fixed
+   * reference neighbourhoods, SPH_DISTRIBUTED_DYNAMIC with the ghosts found
+   * again, migration and re-balancing at its rebuilds (updated Lagrangian) */
+  int distributed;
   unsigned long fields; /* the output fields it fills: bit 1ul << f */
   /* validates the method block, requires fields, creates its terms */
   sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);
@@ -155,6 +162,8 @@ int sph_sim_add_timer(sph_sim *sim, const char *name);
 
 /* Runs every term's rates / constrain hook in order, timing each. */
 sph_status sph_sim_terms_rates(sph_sim *sim, sph_stage *stage, sph_error *err);
+/* every term's renumber hook, after a migration */
+sph_status sph_sim_terms_renumber(sph_sim *sim, sph_error *err);
 sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
                                    sph_error *err);
 

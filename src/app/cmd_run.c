@@ -588,6 +588,13 @@ int sph_cmd_run(int argc, char **argv) {
     printf("mpi: %d ranks; exchanges and reductions at most %.2f s of a "
            "rank's wall (waits included), the rest at most %.2f s\n",
            sph_domain_size(sim->domain), comm, work);
+  sph_domain_moves mv = sph_domain_moves_of(sim->domain);
+  if (mv.rebuilds > 0.0 && !args.quiet)
+    printf("mpi: %.0f halo rebuilds, %.0f particles migrated, %.0f "
+           "re-balances (over %.0f %% imbalance); at most %.0f ghost "
+           "particles a rank, %.0f particles a halo exchange\n",
+           mv.rebuilds, mv.migrated, mv.rebalances,
+           100.0 * SPH_DOMAIN_IMBALANCE, mv.ghosts_max, mv.halo_max);
   if (mp4_tried && mst == SPH_OK)
     printf("mp4: %s (%d frames, %s, %.1f s)\n", mp4.path, mp4.frames, mp4.codec,
            mp4.seconds);

@@ -99,6 +99,14 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
           sim->steps);
   if (sim->domain) /* a run over MPI ranks; the timers are rank 0's */
     fprintf(f, "  \"ranks\": %d,\n", sph_domain_size(sim->domain));
+  sph_domain_moves mv = sph_domain_moves_of(sim->domain);
+  if (mv.rebuilds > 0.0) /* updated Lagrangian: over the run, all ranks */
+    fprintf(f,
+            "  \"halo_rebuilds\": %.0f,\n  \"migrated\": %.0f,\n"
+            "  \"rebalances\": %.0f,\n  \"ghosts_max\": %.0f,\n"
+            "  \"halo_max\": %.0f,\n",
+            mv.rebuilds, mv.migrated, mv.rebalances, mv.ghosts_max,
+            mv.halo_max);
   fputs("  \"wall_seconds\": ", f);
   json_number(f, wall_seconds);
   fputs(",\n  \"dt_min\": ", f);

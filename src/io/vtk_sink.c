@@ -71,7 +71,8 @@ static sph_status vtk_open(sph_sink *sink, const sph_sim *sim, const char *dir,
   v->ascii = sim->scene->output.vtk_ascii;
   v->rank = sph_domain_rank(sim->domain);
   v->ranks = sph_domain_size(sim->domain);
-  v->n = sim->ps->n;
+  /* a piece of an updated-Lagrangian run: up to its set's capacity */
+  v->n = sim->domain ? sim->ps->capacity : sim->ps->n;
   v->cap = (int)(sim->scene->t_end / sim->scene->output.every) + 4;
   v->times = malloc((size_t)v->cap * sizeof *v->times);
   v->ids = malloc((v->n ? v->n : 1) * sizeof *v->ids);

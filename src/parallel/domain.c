@@ -2,8 +2,10 @@
  * bisection of the reference positions balanced by count, ghost layers of
  * one kernel support found with the cell-list search, a fixed halo exchange
  * with MPI_Irecv/MPI_Isend, reductions in rank order and the gather of the
- * output fields to rank 0. Every MPI call of sph is in this file. */
+ * output fields to rank 0. Every MPI call of sph is in this file and
+ * domain_dynamic.c (the updated-Lagrangian rebuild). */
 #include "sph/domain.h"
+#include "parallel/domain_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -62,31 +64,6 @@ void sph_domain_finalize(void) {
 int sph_domain_world_rank(void) { return world_rank; }
 int sph_domain_world_size(void) { return world_size; }
 
-struct sph_domain {
-  int rank, size, dim;
-  size_t n;           /* owned */
-  size_t ng;          /* ghosts */
-  int64_t *gidx;      /* storage index in the whole set: owned, then ghosts */
-  double *gX, *gV;    /* ghosts' reference positions and volumes */
-  int32_t *gbody;     /* ghosts' bodies */
-  int64_t *gid;       /* ghosts' particle ids */
-  int *recv_count;    /* ghosts owned by each rank */
-  int *recv_off;      /* their first ghost */
-  int *send_count;    /* owned particles each rank holds as ghosts */
-  int *send_off;      /* their first entry of send_idx */
-  int32_t *send_idx;  /* owned indices to send, grouped by rank */
-  size_t nsend;       /* entries of send_idx */
-  double *buf;        /* packed sends, 9 per entry */
-  void *req;          /* 2 size requests */
-  sph_particles *all; /* rank 0: the whole set */
-  int *all_count, *all_off; /* rank 0: owned per rank (doubles: scaled) */
-  int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
-  double *gbuf;             /* rank 0: 9 per particle, gathered */
-  int *counts, *offs;       /* rank 0: per-gather counts and offsets */
-  double seconds;           /* in exchanges, reductions and gathers */
-  double *sums;             /* 16 per rank: sph_domain_sum's gather */
-};
-
 int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
 double sph_domain_seconds(const sph_domain *d) { return d ? d->seconds : 0.0; }
 int sph_domain_size(const sph_domain *d) { return d ? d->size : 1; }
@@ -137,15 +114,20 @@ void sph_domain_destroy(sph_domain *d) {
   free(d->counts);
   free(d->offs);
   free(d->sums);
+  sph_domain_dyn_destroy(d->dyn);
   free(d);
 }
 
 /* ---- recursive coordinate bisection ----------------------------------- */
 
-typedef struct rcb_key {
-  double x;
-  int64_t i;
-} rcb_key;
+/* the longest side of a box */
+static int axis_of(const double *lo, const double *hi, int dim) {
+  int axis = 0;
+  for (int c = 1; c < dim; ++c)
+    if (hi[c] - lo[c] > hi[axis] - lo[axis])
+      axis = c;
+  return axis;
+}
 
 static int cmp_rcb(const void *pa, const void *pb) {
   const rcb_key *a = pa, *b = pb;
@@ -156,9 +138,12 @@ static int cmp_rcb(const void *pa, const void *pb) {
 
 /* owner of the n particles idx: halves of the ranks get shares of the
  * particles in proportion, cut across the longest side of their box
- * (ties by storage index, so every rank computes the same partition) */
-static void rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
-                int nranks, int *owner) {
+ * (ties by storage index, so every rank computes the same partition); the
+ * cut between ranks below and from s = rank0 + nranks / 2 on is recorded as
+ * axis[s], cut[s] (halfway between the two sides' nearest particles) when
+ * axis is not NULL */
+void sph_domain_rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
+                    int nranks, int *owner, int *axis, double *cutv) {
   if (nranks == 1) {
     for (size_t i = 0; i < n; ++i)
       owner[k[i].i] = rank0;
@@ -171,17 +156,22 @@ static void rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
       lo[c] = fmin(lo[c], X[3 * k[i].i + c]);
       hi[c] = fmax(hi[c], X[3 * k[i].i + c]);
     }
-  int axis = 0;
-  for (int c = 1; c < dim; ++c)
-    if (hi[c] - lo[c] > hi[axis] - lo[axis])
-      axis = c;
+  int ax = axis_of(lo, hi, dim);
   for (size_t i = 0; i < n; ++i)
-    k[i].x = X[3 * k[i].i + axis];
+    k[i].x = X[3 * k[i].i + ax];
   qsort(k, n, sizeof *k, cmp_rcb);
   int nlo = nranks / 2;
   size_t cut = n * (size_t)nlo / (size_t)nranks;
-  rcb(X, dim, k, cut, rank0, nlo, owner);
-  rcb(X, dim, k + cut, n - cut, rank0 + nlo, nranks - nlo, owner);
+  if (axis) {
+    axis[rank0 + nlo] = ax;
+    cutv[rank0 + nlo] = n == 0     ? 0.0
+                        : cut == 0 ? k[0].x
+                        : cut == n ? k[n - 1].x
+                                   : 0.5 * (k[cut - 1].x + k[cut].x);
+  }
+  sph_domain_rcb(X, dim, k, cut, rank0, nlo, owner, axis, cutv);
+  sph_domain_rcb(X, dim, k + cut, n - cut, rank0 + nlo, nranks - nlo, owner,
+                 axis, cutv);
 }
 
 #ifdef SPH_HAVE_MPI
@@ -241,8 +231,9 @@ static sph_status find_ghosts(const sph_particles *ps, const int *owner, int r,
 
 /* this rank's owned particles as a set of their own, in storage order */
 static sph_status owned_set(const sph_particles *ps, const sph_domain *d,
-                            sph_particles **out, sph_error *err) {
-  SPH_TRY(sph_particles_create(out, d->n, ps->dim, err));
+                            size_t capacity, sph_particles **out,
+                            sph_error *err) {
+  SPH_TRY(sph_particles_create(out, capacity, ps->dim, err));
   sph_particles *o = *out;
   for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
     if (!ps->field[f])
@@ -311,7 +302,7 @@ static sph_status exchange_plan(sph_domain *d, const int *owner,
 
 /* rank 0 learns every rank's owned storage indices (the gather's map) */
 static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
-  int R = d->size, n = (int)d->n;
+  int R = d->size;
   int fail = 0;
   if (d->rank == 0) {
     d->all_count = malloc((size_t)R * sizeof(int));
@@ -325,6 +316,12 @@ static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
   }
   sph_status st = fail ? sph_error_set(err, SPH_ERR_NOMEM, "gather") : SPH_OK;
   SPH_TRY(sph_domain_agree(d, st, err));
+  sph_domain_gather_map(d);
+  return SPH_OK;
+}
+
+void sph_domain_gather_map(sph_domain *d) {
+  int R = d->size, n = (int)d->n;
   MPI_Gather(&n, 1, MPI_INT, d->all_count, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (d->rank == 0) {
     d->all_off[0] = 0;
@@ -333,11 +330,12 @@ static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
   }
   MPI_Gatherv(d->gidx, n, MPI_INT64_T, d->all_gidx, d->all_count, d->all_off,
               MPI_INT64_T, 0, MPI_COMM_WORLD);
-  return SPH_OK;
 }
 
-sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
-                             double support, sph_error *err) {
+/* the partition; a dynamic domain (updated Lagrangian) finds no ghosts
+ * here (sph_domain_rebuild does) and holds its particles with room */
+static sph_status domain_create(sph_domain **out, sph_particles **ps,
+                                double support, int dynamic, sph_error *err) {
   *out = NULL;
   sph_particles *all = *ps;
   size_t N = all->n;
@@ -345,7 +343,10 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
   int *owner = malloc((N ? N : 1) * sizeof *owner);
   char *ghost = calloc(N ? N : 1, 1);
   rcb_key *k = malloc((N ? N : 1) * sizeof *k);
-  sph_status st = d && owner && ghost && k
+  int *axis = malloc(((size_t)world_size + 1) * sizeof *axis);
+  double *cut = malloc(((size_t)world_size + 1) * sizeof *cut);
+  size_t cap = dynamic ? sph_domain_dyn_capacity(N, world_size) : 0;
+  sph_status st = d && owner && ghost && k && axis && cut
                       ? SPH_OK
                       : sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
   if (d) {
@@ -359,8 +360,10 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
   if (st == SPH_OK) {
     for (size_t i = 0; i < N; ++i)
       k[i] = (rcb_key){0.0, (int64_t)i};
-    rcb(all->field[SPH_FIELD_POSITION0], all->dim, k, N, 0, world_size, owner);
-    st = find_ghosts(all, owner, world_rank, support, ghost, err);
+    sph_domain_rcb(all->field[SPH_FIELD_POSITION0], all->dim, k, N, 0,
+                   world_size, owner, axis, cut);
+    if (!dynamic)
+      st = find_ghosts(all, owner, world_rank, support, ghost, err);
   }
   /* owned in storage order, then ghosts by owner and storage order */
   for (size_t i = 0; st == SPH_OK && i < N; ++i) {
@@ -369,6 +372,7 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
   }
   if (st == SPH_OK) {
     size_t m = d->n + d->ng ? d->n + d->ng : 1;
+    m = cap > m ? cap : m;
     d->gidx = malloc(m * sizeof *d->gidx);
     d->gX = malloc(3 * (d->ng + 1) * sizeof *d->gX);
     d->gV = malloc((d->ng + 1) * sizeof *d->gV);
@@ -424,13 +428,18 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
   st = sph_domain_agree(d, st, err);
   sph_particles *mine = NULL;
   if (st == SPH_OK)
-    st = owned_set(all, d, &mine, err);
+    st = owned_set(all, d, cap > d->n ? cap : d->n, &mine, err);
   st = sph_domain_agree(d, st, err);
   if (st == SPH_OK)
     st = gather_plan(d, N, err);
+  if (st == SPH_OK && dynamic)
+    st = sph_domain_dyn_create(d, N, axis, cut, err);
+  st = sph_domain_agree(d, st, err);
   free(owner);
   free(ghost);
   free(k);
+  free(axis);
+  free(cut);
   if (st != SPH_OK) {
     sph_particles_destroy(mine);
     sph_domain_destroy(d);
@@ -444,6 +453,16 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
   *ps = mine;
   *out = d;
   return SPH_OK;
+}
+
+sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
+                             double support, sph_error *err) {
+  return domain_create(out, ps, support, 0, err);
+}
+
+sph_status sph_domain_create_dynamic(sph_domain **out, sph_particles **ps,
+                                     double support, sph_error *err) {
+  return domain_create(out, ps, support, 1, err);
 }
 
 sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
@@ -540,6 +559,8 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
   sph_status st = SPH_OK;
   sph_particles *all = d->all;
   double t0 = MPI_Wtime();
+  if (d->dyn) /* the owned sets change at every migration */
+    sph_domain_gather_map(d);
   for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
     /* the reference positions and volumes never change */
     if (!local->field[f] || f == SPH_FIELD_POSITION0 || f == SPH_FIELD_VOLUME0)
@@ -577,9 +598,14 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
 
 sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
                              double support, sph_error *err) {
-  (void)ps, (void)support, (void)rcb;
+  (void)ps, (void)support;
   *out = NULL;
   return sph_error_set(err, SPH_ERR_UNSUPPORTED, "built without MPI");
+}
+
+sph_status sph_domain_create_dynamic(sph_domain **out, sph_particles **ps,
+                                     double support, sph_error *err) {
+  return sph_domain_create(out, ps, support, err);
 }
 
 sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,

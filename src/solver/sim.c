@@ -154,7 +154,10 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                           "drop output.checkpoint_every or run without "
                           "mpirun");
   }
-  return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
+  if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
+    return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
+  return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,
+                                   err);
 }
 
 /* Every term a distributed method creates must run on owned particles. */

@@ -86,6 +86,25 @@ static sph_status bc_constrain(sph_term *term, sph_sim *sim, sph_stage *state,
   return SPH_OK;
 }
 
+/* the owned particles each boundary selects (by their reference position) */
+static void select_particles(essential_bc *e, const sph_sim *sim) {
+  const sph_particles *ps = sim->ps;
+  for (size_t k = 0; k < e->nsets; ++k) {
+    bc_set *set = &e->sets[k];
+    set->count = 0;
+    for (size_t a = 0; a < ps->n; ++a)
+      if (sph_selection_contains(sim->scene, &set->bc->select, ps->body[a],
+                                 ps->field[SPH_FIELD_POSITION0] + 3 * a))
+        set->index[set->count++] = a;
+  }
+}
+
+static sph_status bc_renumber(sph_term *term, sph_sim *sim, sph_error *err) {
+  (void)err;
+  select_particles(term->data, sim);
+  return SPH_OK;
+}
+
 static void bc_destroy(sph_term *term) {
   essential_bc *e = term->data;
   if (!e)
@@ -102,6 +121,7 @@ static const sph_term_ops essential_bc_ops = {
     .distributed = 1,
     .rates = bc_rates,
     .constrain = bc_constrain,
+    .renumber = bc_renumber,
     .destroy = bc_destroy,
 };
 
@@ -117,19 +137,18 @@ sph_status essential_bc_create(sph_sim *sim, const double *rho0,
   e->rho0 = rho0;
   e->nsets = s->nboundaries;
   sph_term t = {.data = e};
+  /* room for every particle a rank may own after migrations */
+  size_t cap = sph_domain_capacity(sim->domain, ps);
   for (size_t k = 0; k < s->nboundaries; ++k) {
     bc_set *set = &e->sets[k];
     set->bc = &s->boundaries[k];
-    set->index = malloc((ps->n ? ps->n : 1) * sizeof *set->index);
+    set->index = malloc((cap ? cap : 1) * sizeof *set->index);
     if (!set->index) {
       bc_destroy(&t);
       return sph_error_set(err, SPH_ERR_NOMEM, "boundary conditions");
     }
-    for (size_t a = 0; a < ps->n; ++a)
-      if (sph_selection_contains(s, &set->bc->select, ps->body[a],
-                                 ps->field[SPH_FIELD_POSITION0] + 3 * a))
-        set->index[set->count++] = a;
   }
+  select_particles(e, sim);
   sph_status st = sph_sim_add_term(sim, &essential_bc_ops, e, err);
   if (st != SPH_OK)
     bc_destroy(&t);

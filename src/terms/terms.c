@@ -53,3 +53,10 @@ sph_status sph_sim_terms_constrain(sph_sim *sim, sph_stage *state,
   }
   return SPH_OK;
 }
+
+sph_status sph_sim_terms_renumber(sph_sim *sim, sph_error *err) {
+  for (int i = 0; i < sim->nterms; ++i)
+    if (sim->terms[i].ops->renumber)
+      SPH_TRY(sim->terms[i].ops->renumber(&sim->terms[i], sim, err));
+  return SPH_OK;
+}

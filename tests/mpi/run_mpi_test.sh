@@ -10,22 +10,8 @@
 set -u
 sph=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-check() { # name, command...
-  local name=$1
-  shift
-  if "$@" >"$work/out.txt" 2>&1; then
-    echo "ok   $name"
-  else
-    echo "FAIL $name"
-    tail -20 "$work/out.txt"
-    fails=$((fails + 1))
-  fi
-}
-mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
-[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+# shellcheck source=mpi_common.sh
+. "$src/tests/mpi/mpi_common.sh"
 run=(run twisting_column --quiet --set 'method={name: tl-csph}'
   --set time.end=0.05 --set output.every=0.01 --set output.png.width=320
   --set output.png.height=180 --set output.png.mp4=false
@@ -42,14 +28,7 @@ done
 
 # the same rank count and thread count: the same bytes
 check "np 2 again" "${mpi[@]}" -np 2 "$sph" "${run[@]}" --out "$work/np2b"
-same_bytes() {
-  for f in "$work/np2"/* "$work/np2"/frames/*; do
-    b=${f#"$work/np2/"}
-    case $b in summary.json | scene_used.yaml | frames) continue ;; esac
-    cmp -s "$f" "$work/np2b/$b" || { echo "$b differs"; return 1; }
-  done
-}
-check "np 2 twice: identical files" same_bytes
+check "np 2 twice: identical files" same_bytes "$work/np2" "$work/np2b"
 
 # --overwrite removes the pieces of a 4-rank run before a 2-rank one
 check "np 2 --overwrite of np 4" "${mpi[@]}" -np 2 "$sph" "${run[@]}" \
@@ -58,17 +37,6 @@ no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
 check "no stale pieces" no_stale
 
 # refusals: exit 2 on every rank, the folder never made
-refused() { # name, sph args...
-  local out=$work/refused
-  rm -rf "$out"
-  "${mpi[@]}" -np "${np:-2}" "$sph" "$@" --out "$out" >"$work/ref.txt" 2>&1
-  local rc=$?
-  if [ $rc -ne 2 ] || [ -e "$out" ] || ! grep -q "$expect" "$work/ref.txt"; then
-    echo "rc $rc, wanted 2; folder made: $([ -e "$out" ] && echo yes || echo no)"
-    cat "$work/ref.txt"
-    return 1
-  fi
-}
 expect="ul-csph does not run over MPI ranks yet"
 check "ul-csph refused" refused run twisting_column --quiet \
   --set 'method={name: ul-csph}'
@@ -87,6 +55,4 @@ check_other() {
 }
 check "sph check under mpirun refused" check_other
 
-total=11
-echo "$((total - fails)) passed, $fails failed"
-[ $fails -eq 0 ]
+summary

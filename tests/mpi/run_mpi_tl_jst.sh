@@ -19,24 +19,8 @@
 set -u
 sph=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-total=0
-check() { # name, command...
-  local name=$1
-  shift
-  total=$((total + 1))
-  if "$@" >"$work/out.txt" 2>&1; then
-    echo "ok   $name"
-  else
-    echo "FAIL $name"
-    tail -20 "$work/out.txt"
-    fails=$((fails + 1))
-  fi
-}
-mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
-[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+# shellcheck source=mpi_common.sh
+. "$src/tests/mpi/mpi_common.sh"
 fields='output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]'
 column=(run twisting_column --quiet --set time.end=0.05 --set output.every=0.01
   --set output.png.width=320 --set output.png.height=180
@@ -86,27 +70,10 @@ compare bond twisting_column_bond 1e-12 2 -- "${bond[@]}"
 # the same rank count and thread count: the same bytes
 check "punch np 2 again" "${mpi[@]}" -np 2 "$sph" "${punch[@]}" \
   --out "$work/punch.np2b"
-same_bytes() {
-  for f in "$work/punch.np2"/*; do
-    b=${f#"$work/punch.np2/"}
-    case $b in summary.json | scene_used.yaml) continue ;; esac
-    cmp -s "$f" "$work/punch.np2b/$b" || { echo "$b differs"; return 1; }
-  done
-}
-check "punch np 2 twice: identical files" same_bytes
+check "punch np 2 twice: identical files" same_bytes "$work/punch.np2" \
+  "$work/punch.np2b"
 
 # refusals: exit 2 on every rank, the folder never made
-refused() { # sph args...
-  local out=$work/refused
-  rm -rf "$out"
-  "${mpi[@]}" -np 2 "$sph" "$@" --out "$out" >"$work/ref.txt" 2>&1
-  local rc=$?
-  if [ $rc -ne 2 ] || [ -e "$out" ] || ! grep -q "$expect" "$work/ref.txt"; then
-    echo "rc $rc, wanted 2; folder made: $([ -e "$out" ] && echo yes || echo no)"
-    cat "$work/ref.txt"
-    return 1
-  fi
-}
 expect="essential_bc: lagrange does not run over MPI ranks yet"
 check "essential_bc lagrange refused" refused "${punch[@]}" \
   --set method.essential_bc=lagrange
@@ -114,5 +81,4 @@ expect="correction: zeroth_order does not run over MPI ranks yet"
 check "tl-bond zeroth_order refused" refused "${bond[@]}" \
   --set method.correction=zeroth_order
 
-echo "$((total - fails)) passed, $fails failed"
-[ $fails -eq 0 ]
+summary

@@ -45,7 +45,8 @@
 
 /* ---- configuration --------------------------------------------------- */
 
-static double max_speed(const ul_sph *m) {
+/* this rank's largest speed (the serial run's with `global` over ranks) */
+static double max_speed(const ul_sph *m, int global) {
   double vmax2 = 0.0;
   long n = (long)m->n;
 #pragma omp parallel for schedule(static) reduction(max : vmax2)
@@ -53,7 +54,7 @@ static double max_speed(const ul_sph *m) {
     double s = sph_vec3_dot(m->v + 3 * a, m->v + 3 * a);
     vmax2 = s > vmax2 ? s : vmax2;
   }
-  return sqrt(vmax2);
+  return sqrt(global ? sph_domain_max(m->sim->domain, vmax2) : vmax2);
 }
 
 /* neighbours of `pos` and their pair geometry, without touching the time */
@@ -62,8 +63,17 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
   sph_sim *sim = m->sim;
   double t0 = sph_wtime();
   const sph_kernel *k = &sim->kernel;
-  SPH_TRY(sph_neighbors_build(m->nl, pos, m->n, sim->scene->dimension,
+  /* over MPI ranks: migration, re-balance, the ghosts of this rebuild */
+  if (sim->domain && pos == m->x) {
+    SPH_TRY(sph_domain_rebuild(sim->domain, sim->ps, k->support, err));
+    m->n = sim->ps->n;
+    m->ng = sph_domain_ghosts(sim->domain);
+    SPH_TRY(sph_sim_terms_renumber(sim, err));
+  }
+  SPH_TRY(sph_neighbors_build(m->nl, pos, m->n + m->ng, sim->scene->dimension,
                               k->support, NULL, SPH_PAIRS_ALL, err));
+  /* a distributed run sums pairs in the serial run's order */
+  sph_domain_sort_lists(sim->domain, m->nl, m->n);
   size_t count = m->nl->count;
   if (count > m->slot_cap) { /* grow-only, with room for later updates */
     size_t cap = count + count / 2 + 16;
@@ -105,8 +115,10 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
 /* eq. 25: the next update is one advection step away (every acoustic step
  * with single-criterion stepping) */
 static sph_status configuration_update(ul_sph *m, double t, sph_error *err) {
-  SPH_TRY(configuration_build(m, m->x, err));
-  double vmax = max_speed(m);
+  sph_status st = configuration_build(m, m->x, err);
+  /* over MPI ranks every rank learns of a failure before the next all-reduce */
+  SPH_TRY(sph_domain_agree(m->sim->domain, st, err));
+  double vmax = max_speed(m, 1);
   double dt_ad = vmax > 0.0 ? m->cfl_ad * m->sim->kernel.h / vmax : INFINITY;
   m->config[0] = m->dual ? t + dt_ad : t;
   m->config[1] += 1.0;
@@ -118,7 +130,7 @@ static sph_status configuration_update(ul_sph *m, double t, sph_error *err) {
 /* total stress of the artificial stress: R = -eps sigma'/rho^2 on the
  * positive principal stresses, rotated back */
 static void artificial_stress(ul_sph *m) {
-  long n = (long)m->n;
+  long n = (long)(m->n + m->ng);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double S[9], w[3], Q[9], R[9] = {0};
@@ -137,9 +149,9 @@ static void artificial_stress(ul_sph *m) {
   }
 }
 
-/* current volumes m / rho */
+/* current volumes m / rho (ghosts' too) */
 static void volumes(ul_sph *m) {
-  long n = (long)m->n;
+  long n = (long)(m->n + m->ng);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a)
     m->vol[a] = m->m[a] / m->rho[a];
@@ -297,22 +309,33 @@ static ul_sph_loops loops_of(ul_shear shear, int dim, int stress) {
 
 /* the acceleration of the state (pressure at rho, shear), into acc and the
  * shear part into accs */
-static void accelerations(ul_sph *m, double *acc, double *accs) {
+static sph_status accelerations(ul_sph *m, double *acc, double *accs,
+                                sph_error *err) {
   double tp = sph_wtime();
+  if (m->sim->domain) { /* the ghosts' state this pass reads */
+    double *f[] = {m->v, m->rho, m->p, m->sigma};
+    int nc[] = {3, 1, 1, 9};
+    SPH_TRY(sph_domain_exchange_many(
+        m->sim->domain, f, nc, m->shear == UL_SHEAR_LAPLACIAN ? 3 : 4, err));
+  }
   volumes(m);
   if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
     artificial_stress(m);
   m->loops.accelerations(m, acc, accs);
   m->sim->timers[m->timer_pressure].seconds += sph_wtime() - tp;
   m->sim->timers[m->timer_pressure].calls++;
+  return SPH_OK;
 }
 
-static void continuity_and_shear(ul_sph *m, double dt) {
+static sph_status continuity_and_shear(ul_sph *m, double dt, sph_error *err) {
   double tp = sph_wtime();
+  /* the ghosts' new velocities (their density is the pressure pass's) */
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->v, 3, err));
   volumes(m);
   m->loops.continuity(m, dt);
   m->sim->timers[m->timer_shear].seconds += sph_wtime() - tp;
   m->sim->timers[m->timer_shear].calls++;
+  return SPH_OK;
 }
 
 /* ---- method ops -------------------------------------------------------- */
@@ -320,7 +343,8 @@ static void continuity_and_shear(ul_sph *m, double dt) {
 static double ul_sph_stable_dt(sph_sim *sim) {
   ul_sph *m = sim->method_data;
   /* eq. 26 */
-  double dt = m->cfl_ac * sim->kernel.h / (m->c0_max + max_speed(m));
+  /* a rank's own speed: the smallest step over the ranks is the serial one */
+  double dt = m->cfl_ac * sim->kernel.h / (m->c0_max + max_speed(m, 0));
   /* the rest of the advection step in equal acoustic steps */
   double rest = m->config[0] - sim->t;
   if (m->dual && rest > 0.0 && rest < INFINITY)
@@ -331,7 +355,7 @@ static double ul_sph_stable_dt(sph_sim *sim) {
 static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
   ul_sph *m = sim->method_data;
   long n = (long)m->n;
-  double *accs = m->acc + 3 * m->n;
+  double *accs = m->acc + 3 * m->cap;
   double t0 = sph_wtime(), ti; /* the integration's own loops, timed */
   /* eq. 27: half a step of position and density, pressure from eq. 4 */
 #pragma omp parallel for schedule(static)
@@ -342,7 +366,7 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
     m->p[a] = m->c0[a] * m->c0[a] * (m->rho[a] - m->rho0[a]);
   }
   ti = sph_wtime() - t0;
-  accelerations(m, m->acc, accs);
+  SPH_TRY(accelerations(m, m->acc, accs, err));
   sph_stage st = {.t = sim->t + 0.5 * dt, .x = m->x, .p = m->v, .dp = m->acc};
   SPH_TRY(sph_sim_terms_rates(sim, &st, err));
   /* eq. 28, and the work done against the shear force */
@@ -367,7 +391,7 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
     for (int c = 0; c < 3; ++c)
       m->x[3 * a + c] += 0.5 * dt * m->v[3 * a + c];
   ti += sph_wtime() - t0;
-  continuity_and_shear(m, dt);
+  SPH_TRY(continuity_and_shear(m, dt, err));
   t0 = sph_wtime();
   long bad = n; /* the first particle with a non-finite or non-positive state */
 #pragma omp parallel for schedule(static) reduction(min : bad)
@@ -377,20 +401,27 @@ static sph_status ul_sph_step(sph_sim *sim, double dt, sph_error *err) {
         !isfinite(m->v[3 * a + 1]) || !isfinite(m->v[3 * a + 2]))
       bad = a < bad ? a : bad;
   }
+  sph_status fin = SPH_OK;
   if (bad < n)
-    return sph_error_set(err, SPH_ERR_NUMERIC,
-                         isfinite(m->rho[bad]) && isfinite(m->v[3 * bad]) &&
-                                 isfinite(m->v[3 * bad + 1]) &&
-                                 isfinite(m->v[3 * bad + 2])
-                             ? "particle %ld: density %g"
-                             : "particle %ld: non-finite state (density %g)",
-                         bad, m->rho[bad]);
+    fin = sph_error_set(err, SPH_ERR_NUMERIC,
+                        isfinite(m->rho[bad]) && isfinite(m->v[3 * bad]) &&
+                                isfinite(m->v[3 * bad + 1]) &&
+                                isfinite(m->v[3 * bad + 2])
+                            ? "particle %ld: density %g"
+                            : "particle %ld: non-finite state (density %g)",
+                        bad, m->rho[bad]);
+  double t1 = sim->t + dt;
+  /* (an output time may leave a sliver of the advection step: skip it) */
+  int update = !m->dual || t1 >= m->config[0] - 0.1 * dt;
+  /* the update is collective over MPI ranks: none may skip it alone */
+  if (update)
+    fin = sph_domain_agree(sim->domain, fin, err);
+  if (fin != SPH_OK)
+    return fin;
   sph_timer *tm = &sim->timers[m->timer_integration];
   tm->seconds += ti + sph_wtime() - t0;
   tm->calls++;
-  double t1 = sim->t + dt;
-  /* (an output time may leave a sliver of the advection step: skip it) */
-  if (!m->dual || t1 >= m->config[0] - 0.1 * dt)
+  if (update)
     SPH_TRY(configuration_update(m, t1, err));
   return SPH_OK;
 }
@@ -431,7 +462,7 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
     }
   }
   if (acc) { /* the acceleration of this state, terms included */
-    accelerations(m, acc, m->acc + 3 * m->n);
+    SPH_TRY(accelerations(m, acc, m->acc + 3 * m->cap, err));
     sph_stage st = {.t = sim->t, .x = m->x, .p = m->v, .dp = acc};
     SPH_TRY(sph_sim_terms_rates(sim, &st, err));
   }
@@ -563,6 +594,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sim = sim;
   sph_particles *ps = sim->ps;
   size_t n = m->n = ps->n;
+  size_t cap = m->cap = sph_domain_capacity(sim->domain, ps);
 
   /* options */
   static const char *const shears[] = {"original", "artificial-stress",
@@ -645,25 +677,33 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->v = ps->field[SPH_FIELD_VELOCITY];
   m->rho = ps->field[SPH_FIELD_DENSITY];
   double *rho0, *c0, *G;
-  SPH_TRY(alloc(&m->drho, n, err));
-  SPH_TRY(alloc(&m->p, n, err));
-  SPH_TRY(alloc(&m->m, n, err));
-  SPH_TRY(alloc(&rho0, n, err));
+  SPH_TRY(alloc(&m->drho, cap, err));
+  SPH_TRY(alloc(&m->p, cap, err));
+  SPH_TRY(alloc(&m->m, cap, err));
+  SPH_TRY(alloc(&rho0, cap, err));
   m->rho0 = rho0;
-  SPH_TRY(alloc(&c0, n, err));
+  SPH_TRY(alloc(&c0, cap, err));
   m->c0 = c0;
-  SPH_TRY(alloc(&G, n, err));
+  SPH_TRY(alloc(&G, cap, err));
   m->G = G;
-  SPH_TRY(alloc(&m->acc, 6 * n, err));
-  SPH_TRY(alloc(&m->work, n, err));
-  SPH_TRY(alloc(&m->vol, n, err));
-  SPH_TRY(alloc(&m->xcfg, 3 * n, err));
+  SPH_TRY(alloc(&m->acc, 6 * cap, err));
+  SPH_TRY(alloc(&m->work, cap, err));
+  SPH_TRY(alloc(&m->vol, cap, err));
+  SPH_TRY(alloc(&m->xcfg, 3 * cap, err));
   if (m->shear == UL_SHEAR_LAPLACIAN)
-    SPH_TRY(alloc(&m->acc_shear, 3 * n, err));
+    SPH_TRY(alloc(&m->acc_shear, 3 * cap, err));
   if (m->stress)
-    SPH_TRY(alloc(&m->sigma, 9 * n, err));
+    SPH_TRY(alloc(&m->sigma, 9 * cap, err));
   if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
-    SPH_TRY(alloc(&m->R, 9 * n, err));
+    SPH_TRY(alloc(&m->R, 9 * cap, err));
+  /* over MPI ranks: what moves with a particle besides the set's fields */
+  double *moving[] = {m->drho, m->p, m->m, rho0, c0, G, m->work};
+  for (size_t i = 0; i < sizeof moving / sizeof *moving; ++i)
+    SPH_TRY(sph_domain_track(sim->domain, moving[i], 1, err));
+  if (m->acc_shear)
+    SPH_TRY(sph_domain_track(sim->domain, m->acc_shear, 3, err));
+  if (m->sigma)
+    SPH_TRY(sph_domain_track(sim->domain, m->sigma, 9, err));
   const double *X = ps->field[SPH_FIELD_POSITION0];
   const double *V0 = ps->field[SPH_FIELD_VOLUME0];
   for (size_t a = 0; a < n; ++a) {
@@ -678,6 +718,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     ps->field[SPH_FIELD_MASS][a] = m->m[a];
     memcpy(m->x + 3 * a, X + 3 * a, 3 * sizeof *X);
   }
+  m->c0_max = sph_domain_max(sim->domain, m->c0_max);
   m->timer_config = sph_sim_add_timer(sim, "configuration");
   m->timer_pressure = sph_sim_add_timer(sim, "pressure_and_shear_force");
   m->timer_shear = sph_sim_add_timer(sim, "continuity_and_shear_rate");
@@ -699,6 +740,7 @@ const sph_method_ops ul_sph_method_ops = {
              "essentially non-hourglass)",
     .reference = "seed 002 (Zhang et al. 2024) eq. 4-18, 23-31",
     .conserves_angular_momentum = 0, /* seed 002 sec. 6.10 */
+    .distributed = SPH_DISTRIBUTED_DYNAMIC,
     .fields = 1ul << SPH_FIELD_POSITION0 | 1ul << SPH_FIELD_POSITION |
               1ul << SPH_FIELD_VELOCITY | 1ul << SPH_FIELD_ACCELERATION |
               1ul << SPH_FIELD_VOLUME0 | 1ul << SPH_FIELD_MASS |

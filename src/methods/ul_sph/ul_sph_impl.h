@@ -31,7 +31,9 @@ typedef struct ul_sph {
   double cfl_ad, cfl_ac, zeta;
   double c0_max;              /* largest c0 of the bodies (eq. 26) */
   double as_eps, as_n, as_w0; /* artificial stress: epsilon, n, W(dp) */
-  size_t n;
+  size_t n;   /* owned particles (over MPI ranks: this rank's) */
+  size_t ng;  /* ghosts after them (over MPI ranks), else 0 */
+  size_t cap; /* particles the arrays hold: n, or the domain's capacity */
   /* per particle */
   double *x, *v, *rho, *drho, *p, *m; /* x, v: particle fields */
   const double *rho0, *c0, *G;

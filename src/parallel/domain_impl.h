@@ -1,0 +1,56 @@
+/* Private state of the domain decomposition (issue 20), shared by the
+ * fixed halo of the total-Lagrangian methods (domain.c) and the rebuilt
+ * halo, migration and re-balancing of the updated-Lagrangian ones
+ * (domain_dynamic.c). */
+#ifndef SPH_DOMAIN_IMPL_H
+#define SPH_DOMAIN_IMPL_H
+
+#include "sph/domain.h"
+
+typedef struct sph_domain_dyn sph_domain_dyn;
+
+struct sph_domain {
+  int rank, size, dim;
+  size_t n;           /* owned */
+  size_t ng;          /* ghosts */
+  int64_t *gidx;      /* storage index in the whole set: owned, then ghosts */
+  double *gX, *gV;    /* ghosts' reference positions and volumes */
+  int32_t *gbody;     /* ghosts' bodies */
+  int64_t *gid;       /* ghosts' particle ids */
+  int *recv_count;    /* ghosts owned by each rank */
+  int *recv_off;      /* their first ghost */
+  int *send_count;    /* owned particles each rank holds as ghosts */
+  int *send_off;      /* their first entry of send_idx */
+  int32_t *send_idx;  /* owned indices to send, grouped by rank */
+  size_t nsend;       /* entries of send_idx */
+  double *buf;        /* packed sends, 9 per entry (dynamic: wider) */
+  void *req;          /* 2 size requests */
+  sph_particles *all; /* rank 0: the whole set */
+  int *all_count, *all_off; /* rank 0: owned per rank (doubles: scaled) */
+  int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
+  double *gbuf;             /* rank 0: 9 per particle, gathered */
+  int *counts, *offs;       /* rank 0: per-gather counts and offsets */
+  double seconds;           /* in exchanges, reductions and gathers */
+  double *sums;             /* 16 per rank: sph_domain_sum's gather */
+  sph_domain_dyn *dyn;      /* updated-Lagrangian runs, else NULL */
+};
+
+typedef struct rcb_key {
+  double x;
+  int64_t i;
+} rcb_key;
+
+void sph_domain_rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
+                    int nranks, int *owner, int *axis, double *cutv);
+
+/* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
+ * over R ranks; the dynamic state from the first partition (owner of every
+ * particle of the whole set, the cut tree); its destruction */
+size_t sph_domain_dyn_capacity(size_t N, int R);
+sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
+                                 const double *cut, sph_error *err);
+void sph_domain_dyn_destroy(sph_domain_dyn *y);
+/* rank 0: refreshes the gather's map after a migration (collective) */
+void sph_domain_gather_map(sph_domain *d);
+
+#endif

@@ -1,0 +1,47 @@
+# The frame of the MPI test scripts (sourced after `set -u`, with $sph set):
+# a scratch folder removed on exit, check NAME COMMAND... counting checks and
+# failures (summary prints them and fails on any), the mpirun command line
+# (one thread a rank, oversubscribed; as root allowed), same_bytes A B (two
+# runs' files equal but for the timings) and refused SPH_ARGS... (exit 2 on
+# every rank of ${np:-2}, no folder made, the message $expect).
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+total=0
+check() { # name, command...
+  local name=$1
+  shift
+  total=$((total + 1))
+  if "$@" >"$work/out.txt" 2>&1; then
+    echo "ok   $name"
+  else
+    echo "FAIL $name"
+    tail -20 "$work/out.txt"
+    fails=$((fails + 1))
+  fi
+}
+mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
+[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+same_bytes() { # run folder, run folder
+  for f in "$1"/* "$1"/frames/*; do
+    [ -f "$f" ] || continue # frames/* of a run without frames
+    b=${f#"$1/"}
+    case $b in summary.json | scene_used.yaml | frames) continue ;; esac
+    cmp -s "$f" "$2/$b" || { echo "$b differs"; return 1; }
+  done
+}
+refused() { # sph args...
+  local out=$work/refused
+  rm -rf "$out"
+  "${mpi[@]}" -np "${np:-2}" "$sph" "$@" --out "$out" >"$work/ref.txt" 2>&1
+  local rc=$?
+  if [ $rc -ne 2 ] || [ -e "$out" ] || ! grep -q "$expect" "$work/ref.txt"; then
+    echo "rc $rc, wanted 2; folder made: $([ -e "$out" ] && echo yes || echo no)"
+    cat "$work/ref.txt"
+    return 1
+  fi
+}
+summary() {
+  echo "$((total - fails)) passed, $fails failed"
+  [ $fails -eq 0 ]
+}
