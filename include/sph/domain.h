@@ -73,6 +73,10 @@ double sph_domain_max(sph_domain *d, double v);
 void sph_domain_sum(sph_domain *d, double *v, int count);
 /* Root's value on every rank. */
 int sph_domain_bcast_int(sph_domain *d, int v);
+/* Rank 0 receives count values of every rank in rank order (out: count
+ * per rank; unused on the other ranks). */
+void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
+                           uint64_t *out);
 
 /* Every rank learns whether any failed: the error of the lowest failing
  * rank is returned on all (st itself for NULL). */

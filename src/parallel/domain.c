@@ -513,6 +513,13 @@ int sph_domain_bcast_int(sph_domain *d, int v) {
   return v;
 }
 
+void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
+                           uint64_t *out) {
+  if (d)
+    MPI_Gather(v, count, MPI_UINT64_T, out, count, MPI_UINT64_T, 0,
+               MPI_COMM_WORLD);
+}
+
 sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   if (!d)
     return st;
@@ -594,6 +601,10 @@ void sph_domain_sum(sph_domain *d, double *v, int count) {
   (void)d, (void)v, (void)count;
 }
 int sph_domain_bcast_int(sph_domain *d, int v) { return (void)d, v; }
+void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
+                           uint64_t *out) {
+  (void)d, (void)v, (void)count, (void)out;
+}
 sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   (void)d, (void)err;
   return st;

@@ -121,7 +121,6 @@ static sph_status check_memory(const sph_scene *scene, double support,
  * far: refused, the same on every rank, before anything is written. */
 static sph_status distribute(sph_sim *sim, sph_error *err) {
   const sph_scene *s = sim->scene;
-  const sph_node *out = sph_node_child(s->root, "output");
   const sph_node *bcs = sph_node_child(s->root, "boundaries");
   if (!sim->method->distributed) {
     const sph_node *name = sph_node_child(s->method, "name");
@@ -141,13 +140,6 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     return sph_node_error(s->root, err, SPH_ERR_UNSUPPORTED,
                           "a scene reference (initial state) does not run "
                           "over MPI ranks yet; run without mpirun");
-  if (s->output.checkpoint_every > 0.0) {
-    const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;
-    return sph_node_error(ck ? ck : s->root, err, SPH_ERR_UNSUPPORTED,
-                          "checkpoints are not written over MPI ranks yet; "
-                          "drop output.checkpoint_every or run without "
-                          "mpirun");
-  }
   return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
 }
 
