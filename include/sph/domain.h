@@ -85,6 +85,9 @@ sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err);
 /* Wall seconds this rank spent in halo exchanges, reductions and gathers
  * (waiting for the other ranks included). */
 double sph_domain_seconds(const sph_domain *d);
+/* The doubles and messages this rank's halo exchanges have sent so far
+ * (0 for NULL). */
+void sph_domain_traffic(const sph_domain *d, double *values, double *messages);
 
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
 sph_particles *sph_domain_global(const sph_domain *d);

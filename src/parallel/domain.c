@@ -84,12 +84,17 @@ struct sph_domain {
   double *gbuf;             /* rank 0: 9 per particle, gathered */
   int *counts, *offs;       /* rank 0: per-gather counts and offsets */
   double seconds;           /* in exchanges, reductions and gathers */
+  double sent, messages;    /* doubles and messages the exchanges sent */
   double *sums;             /* 16 per rank: sph_domain_sum's gather */
 };
 
 int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
 double sph_domain_seconds(const sph_domain *d) { return d ? d->seconds : 0.0; }
 int sph_domain_size(const sph_domain *d) { return d ? d->size : 1; }
+void sph_domain_traffic(const sph_domain *d, double *values, double *messages) {
+  *values = d ? d->sent : 0.0;
+  *messages = d ? d->messages : 0.0;
+}
 size_t sph_domain_ghosts(const sph_domain *d) { return d ? d->ng : 0; }
 const double *sph_domain_ghost_X(const sph_domain *d) { return d->gX; }
 const double *sph_domain_ghost_volume(const sph_domain *d) { return d->gV; }
@@ -465,9 +470,12 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
     memcpy(d->buf + nc * (size_t)k, field + nc * (size_t)d->send_idx[k],
            nc * sizeof(double));
   for (int q = 0; q < d->size; ++q)
-    if (d->send_count[q])
+    if (d->send_count[q]) {
       MPI_Isend(d->buf + nc * (size_t)d->send_off[q], ncomp * d->send_count[q],
                 MPI_DOUBLE, q, 7, MPI_COMM_WORLD, &req[nr++]);
+      d->sent += (double)(ncomp * d->send_count[q]);
+      d->messages += 1.0;
+    }
   int rc = MPI_Waitall(nr, req, MPI_STATUSES_IGNORE);
   d->seconds += MPI_Wtime() - t0;
   if (rc != MPI_SUCCESS)
