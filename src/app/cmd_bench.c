@@ -386,6 +386,29 @@ static void cpu_model(char *out, size_t len) {
     fclose(f);
 }
 
+/* the JSON's opening: schema, suite and machine */
+static void json_head(FILE *f, const char *suite, long cores) {
+  char cpu[256];
+  cpu_model(cpu, sizeof cpu);
+  fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
+          BENCH_SCHEMA, suite);
+  fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
+  json_str(f, cpu);
+  fprintf(f, "},\n");
+}
+
+/* closes the JSON written to tmp and renames it to path; -1 on failure */
+static int json_finish(FILE *f, const char *tmp, const char *path) {
+  int bad = ferror(f) != 0;
+  bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
+  bad |= fclose(f) != 0;
+  if (bad || rename(tmp, path) != 0) {
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
 static int write_json(const char *path, const bench_case *cases, int ncases,
                       const bench_result *res, int nthr, int quick, long cores,
                       long baseline_kb) {
@@ -394,13 +417,8 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
   FILE *f = fopen(tmp, "w");
   if (!f)
     return -1;
-  char cpu[256];
-  cpu_model(cpu, sizeof cpu);
-  fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
-          BENCH_SCHEMA, quick ? "quick" : "full");
-  fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
-  json_str(f, cpu);
-  fprintf(f, "},\n  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
+  json_head(f, quick ? "quick" : "full", cores);
+  fprintf(f, "  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
           baseline_kb / 1024.0);
   for (int c = 0; c < ncases; ++c)
     for (int t = 0; t < nthr; ++t) {
@@ -437,14 +455,7 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
       fprintf(f, "}}");
     }
   fprintf(f, "\n  ]\n}\n");
-  int bad = ferror(f) != 0;
-  bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
-  bad |= fclose(f) != 0;
-  if (bad || rename(tmp, path) != 0) {
-    remove(tmp);
-    return -1;
-  }
-  return 0;
+  return json_finish(f, tmp, path);
 }
 
 /* empties and removes the suite's own temporary folder (one level of
@@ -549,19 +560,14 @@ static sph_status mpi_measure(const bench_case *c, int weak, mpi_result *m,
 
 static int mpi_json(const char *path, const bench_case *c, const mpi_result *m,
                     int quick, int weak, int ranks, int threads) {
-  char tmp[1100], cpu[256];
+  char tmp[1100];
   snprintf(tmp, sizeof tmp, "%s.part", path);
   FILE *f = fopen(tmp, "w");
   if (!f)
     return -1;
-  cpu_model(cpu, sizeof cpu);
-  fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
-          BENCH_SCHEMA, quick ? "mpi-quick" : "mpi");
-  fprintf(f, "  \"scaling\": \"%s\",\n", weak ? "weak" : "strong");
-  fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ",
-          sysconf(_SC_NPROCESSORS_ONLN));
-  json_str(f, cpu);
-  fprintf(f, "},\n  \"cases\": [\n    {\"name\": ");
+  json_head(f, quick ? "mpi-quick" : "mpi", sysconf(_SC_NPROCESSORS_ONLN));
+  fprintf(f, "  \"scaling\": \"%s\",\n  \"cases\": [\n    {\"name\": ",
+          weak ? "weak" : "strong");
   json_str(f, c->name);
   fprintf(f,
           ", \"ok\": true, \"ranks\": %d, \"threads\": %d, "
@@ -574,14 +580,7 @@ static int mpi_json(const char *path, const bench_case *c, const mpi_result *m,
           ranks, threads, m->particles, m->steps, m->setup, m->first, m->wall,
           (double)m->particles * (double)m->steps / m->wall, m->comm, m->values,
           m->messages, m->halo.max_owned, m->halo.max_ghosts, m->rss_mb);
-  int bad = ferror(f) != 0;
-  bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
-  bad |= fclose(f) != 0;
-  if (bad || rename(tmp, path) != 0) {
-    remove(tmp);
-    return -1;
-  }
-  return 0;
+  return json_finish(f, tmp, path);
 }
 
 /* sph bench --mpi: rank 0 prints and writes the JSON */

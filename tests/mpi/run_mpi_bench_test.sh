@@ -8,12 +8,7 @@
 # 2). No timing thresholds: machines are shared.
 set -u
 sph=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
-[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+. "$(dirname "$0")/mpi_harness.sh"
 
 "$sph" bench --mpi --quick --json "$work/r1.json" || fail "1 rank: exit $?"
 "${mpi[@]}" -np 2 "$sph" bench --mpi --quick --json "$work/r2.json" ||

@@ -9,12 +9,7 @@
 set -u
 sph=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
-[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+. "$(dirname "$0")/mpi_harness.sh"
 # a frame (2 .vtp pieces, a .pvtp, the .pvd, a PNG) every 5 to 6 steps and
 # a checkpoint every 0.005 s: a kill often lands in a write
 run=(run twisting_column --quiet --set 'method={name: tl-csph}'

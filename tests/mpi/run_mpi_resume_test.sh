@@ -11,12 +11,7 @@
 # run_mpi_resume_test.sh SPH SOURCE_DIR
 set -u
 sph=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
-[ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+. "$(dirname "$0")/mpi_harness.sh"
 # 3,969 particles: long enough (1.5 s and more) for mpirun to pass SIGTERM
 run=(run twisting_column --quiet --set 'method={name: tl-csph}'
   --set 'bodies.0.particles.count=[9,49,9]' --set time.end=0.1 --set output.every=0.01 --set output.png=false
