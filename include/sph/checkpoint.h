@@ -16,7 +16,18 @@
  *   the arrays' f64 data
  *   u32 crc32 of everything before it (zlib)
  * A file is accepted only when every field matches the simulation it is
- * loaded into and the checksum holds; nothing is changed otherwise. */
+ * loaded into and the checksum holds; nothing is changed otherwise.
+ *
+ * Over MPI ranks (sim->domain) rank R writes its owned particles' state in
+ * this layout as the piece checkpoint_S_pR.sphc, then rank 0 the text
+ * manifest checkpoint_S.sphm: "manifest 1", scene, method, ranks, step,
+ * time (%.17g), one line "piece R NAME BYTES CRC32" per rank and last
+ * "crc" with the CRC-32 of the lines before it. The slot S (a or b) is the
+ * one not holding the newest complete checkpoint, and its manifest is
+ * removed before its pieces are rewritten: a checkpoint exists only once
+ * its manifest does, and the one before stays whole until then. A resume
+ * needs the same rank count (the partition is the same) and takes the
+ * newest manifest whose every piece holds. */
 #ifndef SPH_CHECKPOINT_H
 #define SPH_CHECKPOINT_H
 

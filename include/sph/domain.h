@@ -73,6 +73,10 @@ double sph_domain_max(sph_domain *d, double v);
 void sph_domain_sum(sph_domain *d, double *v, int count);
 /* Root's value on every rank. */
 int sph_domain_bcast_int(sph_domain *d, int v);
+/* Rank 0 receives count values of every rank in rank order (out: count
+ * per rank; unused on the other ranks). */
+void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
+                           uint64_t *out);
 
 /* Every rank learns whether any failed: the error of the lowest failing
  * rank is returned on all (st itself for NULL). */
@@ -81,6 +85,13 @@ sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err);
 /* Wall seconds this rank spent in halo exchanges, reductions and gathers
  * (waiting for the other ranks included). */
 double sph_domain_seconds(const sph_domain *d);
+/* The doubles and messages this rank's halo exchanges have sent so far
+ * (0 for NULL). */
+void sph_domain_traffic(const sph_domain *d, double *values, double *messages);
+
+/* Whether particles migrate between ranks (an updated-Lagrangian run; 0
+ * for NULL): their checkpoints are not written yet. */
+int sph_domain_migrates(const sph_domain *d);
 
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
 sph_particles *sph_domain_global(const sph_domain *d);

@@ -63,7 +63,8 @@ enum {
   SPH_OPT_KEYS,
   SPH_OPT_MAX_MEMORY,
   SPH_OPT_RESOLVED,
-  SPH_OPT_CASE /* bench: --case TEXT */
+  SPH_OPT_CASE, /* bench: --case TEXT */
+  SPH_OPT_MPI   /* bench: --mpi */
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows

@@ -3,7 +3,10 @@
  * memory (the child's maximum resident set) is its own, on one thread and
  * on every core. Prints a table and, with --json FILE, writes the figures.
  * It times the solver's own steps and timers (those summary.json reports);
- * nothing here is a test threshold: machines are shared and noisy. */
+ * nothing here is a test threshold: machines are shared and noisy. With
+ * --mpi it runs one case in this process over the ranks its launcher
+ * started (mpirun -np N sph bench --mpi; one rank without a launcher) and
+ * adds the halo traffic and the time in exchanges to the figures. */
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -17,6 +20,7 @@
 #include <unistd.h>
 
 #include "app/app_impl.h"
+#include "sph/domain.h"
 #include "sph/render.h"
 #include "sph/scene.h"
 #include "sph/sim.h"
@@ -382,6 +386,34 @@ static void cpu_model(char *out, size_t len) {
     fclose(f);
 }
 
+/* the JSON's opening: schema, suite and machine */
+/* the head and the machine; triad: the memory bandwidth on ntriad thread
+ * counts (none: ntriad 0) */
+static void json_head(FILE *f, const char *suite, long cores,
+                      const double *triad, int ntriad) {
+  char cpu[256];
+  cpu_model(cpu, sizeof cpu);
+  fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
+          BENCH_SCHEMA, suite);
+  fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
+  json_str(f, cpu);
+  for (int t = 0; t < ntriad; ++t)
+    fprintf(f, "%s%.4g", t ? ", " : ", \"triad_gb_per_s\": [", triad[t] / 1e9);
+  fprintf(f, "%s},\n", ntriad ? "]" : "");
+}
+
+/* closes the JSON written to tmp and renames it to path; -1 on failure */
+static int json_finish(FILE *f, const char *tmp, const char *path) {
+  int bad = ferror(f) != 0;
+  bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
+  bad |= fclose(f) != 0;
+  if (bad || rename(tmp, path) != 0) {
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
 static int write_json(const char *path, const bench_case *cases, int ncases,
                       const bench_result *res, int nthr, int quick, long cores,
                       long baseline_kb, const double triad[2]) {
@@ -390,16 +422,8 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
   FILE *f = fopen(tmp, "w");
   if (!f)
     return -1;
-  char cpu[256];
-  cpu_model(cpu, sizeof cpu);
-  fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
-          BENCH_SCHEMA, quick ? "quick" : "full");
-  fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
-  json_str(f, cpu);
-  fprintf(f, ", \"triad_gb_per_s\": [%.4g", triad[0] / 1e9);
-  for (int t = 1; t < nthr; ++t)
-    fprintf(f, ", %.4g", triad[t] / 1e9);
-  fprintf(f, "]},\n  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
+  json_head(f, quick ? "quick" : "full", cores, triad, nthr);
+  fprintf(f, "  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
           baseline_kb / 1024.0);
   for (int c = 0; c < ncases; ++c)
     for (int t = 0; t < nthr; ++t) {
@@ -436,14 +460,7 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
       fprintf(f, "}}");
     }
   fprintf(f, "\n  ]\n}\n");
-  int bad = ferror(f) != 0;
-  bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
-  bad |= fclose(f) != 0;
-  if (bad || rename(tmp, path) != 0) {
-    remove(tmp);
-    return -1;
-  }
-  return 0;
+  return json_finish(f, tmp, path);
 }
 
 /* empties and removes the suite's own temporary folder (one level of
@@ -466,8 +483,160 @@ static void remove_dir_files(const char *dir) {
   }
 }
 
+/* --mpi: the tl-csph column at 202,771 particles, as docs/results.md's
+ * 1 -> 2 rank scaling (full: 100 steps, quick: 10) */
+static const bench_case mpi_cases[2] = {
+    {"twisting column tl-csph over MPI ranks",
+     "twisting_column",
+     {"bodies.0.particles.count=[31,211,31]", "method={name: tl-csph}"},
+     100,
+     0},
+    {"twisting column tl-csph over MPI ranks",
+     "twisting_column",
+     {"bodies.0.particles.count=[31,211,31]", "method={name: tl-csph}"},
+     10,
+     0},
+};
+
+/* what --mpi measured (the slowest rank's times, the sums' traffic) */
+typedef struct mpi_result {
+  long particles, steps;
+  double setup, first, wall, comm, values, messages, rss_mb;
+  sph_halo halo;
+} mpi_result;
+
+/* the case on this process's rank; collective over the ranks */
+static sph_status mpi_measure(const bench_case *c, int weak, mpi_result *m,
+                              sph_error *err) {
+  const char *sets[BENCH_MAX_SETS + 8];
+  size_t n = 0;
+  for (int i = 0; i < BENCH_MAX_SETS && c->sets[i]; ++i)
+    sets[n++] = c->sets[i];
+  /* weak: 101,866 particles a rank, the column 3 m a rank tall at the
+   * strong case's spacing */
+  char count[64], height[64];
+  int R = sph_domain_world_size();
+  snprintf(count, sizeof count, "bodies.0.particles.count=[31,%d,31]",
+           105 * R + 1);
+  snprintf(height, sizeof height, "bodies.0.shape.box.max=[0.5,%d,0.5]", 3 * R);
+  if (weak) {
+    sets[0] = count;
+    sets[n++] = height;
+  }
+  for (size_t i = 0; i < sizeof outputs_off / sizeof *outputs_off; ++i)
+    sets[n++] = outputs_off[i];
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s.yaml", sph_app_scenes_dir(), c->scene);
+  sph_scene *scene = NULL;
+  sph_sim *sim = NULL;
+  double t0 = sph_wtime();
+  sph_status st = sph_scene_load(&scene, path, sets, n, err);
+  if (st == SPH_OK) /* errors before and in the partition: on every rank */
+    st = sph_sim_create(&sim, scene, err);
+  if (st == SPH_OK) {
+    sph_domain *d = sim->domain;
+    m->setup = sph_domain_max(d, sph_wtime() - t0);
+    t0 = sph_wtime(); /* first touch of the work arrays, timed apart */
+    st = sph_sim_step(sim, scene->t_end - sim->t, err);
+    m->first = sph_domain_max(d, sph_wtime() - t0);
+    double v0, k0, v1, k1, comm0 = sph_domain_seconds(d);
+    sph_domain_traffic(d, &v0, &k0);
+    t0 = sph_wtime();
+    for (long k = 0; k < c->steps && st == SPH_OK; ++k)
+      st = sph_sim_step(sim, scene->t_end - sim->t, err);
+    m->wall = sph_domain_max(d, sph_wtime() - t0);
+    m->comm = sph_domain_max(d, sph_domain_seconds(d) - comm0);
+    m->steps = c->steps;
+    sph_domain_traffic(d, &v1, &k1);
+    double sums[3] = {v1 - v0, k1 - k0, (double)sim->ps->n};
+    sph_domain_sum(d, sums, 3);
+    m->values = sums[0] / (double)c->steps;
+    m->messages = sums[1] / (double)c->steps;
+    m->particles = (long)sums[2];
+    m->halo = sph_domain_halo(d);
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    m->rss_mb = sph_domain_max(d, (double)ru.ru_maxrss / 1024.0);
+  }
+  sph_sim_destroy(sim);
+  sph_scene_destroy(scene);
+  return st;
+}
+
+static int mpi_json(const char *path, const bench_case *c, const mpi_result *m,
+                    int quick, int weak, int ranks, int threads) {
+  char tmp[1100];
+  snprintf(tmp, sizeof tmp, "%s.part", path);
+  FILE *f = fopen(tmp, "w");
+  if (!f)
+    return -1;
+  json_head(f, quick ? "mpi-quick" : "mpi", sysconf(_SC_NPROCESSORS_ONLN), NULL,
+            0);
+  fprintf(f, "  \"scaling\": \"%s\",\n  \"cases\": [\n    {\"name\": ",
+          weak ? "weak" : "strong");
+  json_str(f, c->name);
+  fprintf(f,
+          ", \"ok\": true, \"ranks\": %d, \"threads\": %d, "
+          "\"particles\": %ld, \"steps\": %ld, \"setup_seconds\": %.6g, "
+          "\"first_step_seconds\": %.6g, \"step_seconds\": %.6g, "
+          "\"particle_steps_per_second\": %.6g, "
+          "\"exchange_seconds\": %.6g, \"halo_values_per_step\": %.6g, "
+          "\"halo_messages_per_step\": %.6g, \"max_owned\": %.0f, "
+          "\"max_ghosts\": %.0f, \"peak_rss_mb_per_rank\": %.3f}\n  ]\n}\n",
+          ranks, threads, m->particles, m->steps, m->setup, m->first, m->wall,
+          (double)m->particles * (double)m->steps / m->wall, m->comm, m->values,
+          m->messages, m->halo.max_owned, m->halo.max_ghosts, m->rss_mb);
+  return json_finish(f, tmp, path);
+}
+
+/* sph bench --mpi: rank 0 prints and writes the JSON */
+static int bench_mpi(int quick, int weak, int threads, const char *json) {
+  const bench_case *c = &mpi_cases[quick];
+  int root = sph_domain_world_rank() == 0, ranks = sph_domain_world_size();
+  if (!root && !freopen("/dev/null", "w", stdout))
+    return SPH_EXIT_IO;
+  omp_set_num_threads(threads);
+  printf("sph bench --mpi (%s%s): %s, %ld steps on %d rank%s of %d "
+         "thread%s, %ld cores here\n",
+         quick ? "quick" : "full",
+         weak ? ", weak: 31 x (105 N + 1) x 31" : ", strong: 31 x 211 x 31",
+         c->name, c->steps, ranks, ranks == 1 ? " (no launcher)" : "s (MPI)",
+         threads, threads == 1 ? "" : "s", sysconf(_SC_NPROCESSORS_ONLN));
+  fflush(stdout);
+  mpi_result m;
+  memset(&m, 0, sizeof m);
+  sph_error err;
+  sph_error_clear(&err);
+  if (mpi_measure(c, weak, &m, &err) != SPH_OK) {
+    sph_app_print_error(&err);
+    return SPH_EXIT_FAIL;
+  }
+  double rate = (double)m.particles * (double)m.steps / m.wall;
+  printf("  %ld particles, %ld steps: %.3f s, %.4g particle-steps/s (%.4g a "
+         "rank); set-up %.2f s, first step %.3f s\n",
+         m.particles, m.steps, m.wall, rate, rate / ranks, m.setup, m.first);
+  if (ranks > 1)
+    printf("  halo: at most %.0f owned and %.0f ghost particles a rank; %.0f "
+           "values (%.0f kB) in %.0f messages per step\n",
+           m.halo.max_owned, m.halo.max_ghosts, m.values, 8e-3 * m.values,
+           m.messages);
+  printf("  exchanges and reductions: at most %.3f s of a rank's %.3f s "
+         "(%.1f %%, waits included); peak resident set %.0f MB a rank\n",
+         m.comm, m.wall, 100.0 * m.comm / m.wall, m.rss_mb);
+  if (ranks == 1)
+    printf("  no halo on one rank; over N ranks: mpirun -np N sph bench "
+           "--mpi%s (or srun)\n",
+           quick ? " --quick" : "");
+  int rc = SPH_EXIT_OK;
+  if (root && json && mpi_json(json, c, &m, quick, weak, ranks, threads) != 0) {
+    fprintf(stderr, "sph bench: cannot write %s\n", json);
+    rc = SPH_EXIT_IO;
+  }
+  return rc;
+}
+
 typedef struct bench_args {
-  int quick, threads;
+  int quick, threads, mpi;
   const char *json;
   const char *only; /* run only the cases whose name contains it */
 } bench_args;
@@ -484,6 +653,9 @@ static int bench_option(void *ctx, int id, const char *val) {
   case SPH_OPT_CASE:
     b->only = val;
     return SPH_EXIT_OK;
+  case SPH_OPT_MPI:
+    b->mpi = 1;
+    return SPH_EXIT_OK;
   case SPH_OPT_THREADS:
     return sph_app_count("bench", "threads", val, 1024, &b->threads);
   default:
@@ -491,21 +663,42 @@ static int bench_option(void *ctx, int id, const char *val) {
   }
 }
 
-static const int bench_allowed[] = {SPH_OPT_QUICK, SPH_OPT_JSON,
-                                    SPH_OPT_THREADS, SPH_OPT_CASE, 0};
+static const int bench_allowed[] = {
+    SPH_OPT_QUICK, SPH_OPT_JSON, SPH_OPT_THREADS, SPH_OPT_CASE, SPH_OPT_MPI, 0};
 static const sph_app_command bench_command = {
     "bench",
     "usage: sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
+    "       [mpirun -np N] sph bench --mpi [--quick] [--json FILE] "
+    "[--threads N]\n"
     "  throughput, split and memory of a fixed suite of the shipped scenes\n"
-    "  (--case: only the case named TEXT, else those whose name contains "
-    "it)\n",
+    "  (--case: only the case named TEXT, else those whose name contains\n"
+    "  it); --mpi: the tl-csph column at 202,771 particles over the ranks\n"
+    "  the launcher started (one without), N threads a rank (default 1);\n"
+    "  --mpi --case weak: 101,866 particles a rank\n",
     bench_allowed, bench_option, NULL};
 
 int sph_cmd_bench(int argc, char **argv) {
-  bench_args b = {0, 0, NULL, NULL};
+  bench_args b = {0, 0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
+  int weak = b.only && !strcmp(b.only, "weak");
+  if (b.mpi && b.only && !weak && strcmp(b.only, "strong")) {
+    if (sph_domain_world_rank() == 0)
+      fprintf(stderr,
+              "sph bench: --mpi runs the case strong (the "
+              "default) or weak, not '%s'\n",
+              b.only);
+    return SPH_EXIT_USAGE;
+  }
+  if (b.mpi)
+    return bench_mpi(b.quick, weak, b.threads ? b.threads : 1, b.json);
+  if (sph_domain_world_size() > 1) { /* forks a process per case */
+    if (sph_domain_world_rank() == 0)
+      fprintf(stderr, "sph bench: under mpirun only 'sph bench --mpi' "
+                      "runs\n");
+    return SPH_EXIT_USAGE;
+  }
   int quick = b.quick, threads = b.threads;
   const char *json = b.json;
   const bench_case *suite = quick ? quick_cases : full_cases;

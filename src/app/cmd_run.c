@@ -59,6 +59,19 @@ static int piece_file(const char *name, const char *scene) {
                         !strcmp(rest + digits, ".vtp.part"));
 }
 
+/* name is a checkpoint piece or manifest of a run over MPI ranks,
+ * checkpoint_S_pR.sphc or checkpoint_S.sphm (slot S a or b), or .part */
+static int checkpoint_piece(const char *name) {
+  if (strncmp(name, "checkpoint_", 11) || (name[11] != 'a' && name[11] != 'b'))
+    return 0;
+  const char *rest = name + 12;
+  if (!strcmp(rest, ".sphm") || !strcmp(rest, ".sphm.part"))
+    return 1;
+  size_t digits = strncmp(rest, "_p", 2) ? 0 : strspn(rest + 2, "0123456789");
+  rest += 2 + digits;
+  return digits > 0 && (!strcmp(rest, ".sphc") || !strcmp(rest, ".sphc.part"));
+}
+
 /* Removes the files in dir that the run named `scene` writes, and its
  * temporary (.part) ones. */
 static void remove_run_files(const char *dir, const char *scene) {
@@ -91,7 +104,8 @@ static void remove_run_files(const char *dir, const char *scene) {
         ours = run_file(e->d_name, scene, *x, 1);
       for (const char *const *x = single; *x && !ours && k == 0; ++x)
         ours = run_file(e->d_name, scene, *x, 0);
-      ours = ours || (k == 0 && piece_file(e->d_name, scene));
+      ours = ours || (k == 0 && (piece_file(e->d_name, scene) ||
+                                 checkpoint_piece(e->d_name)));
       if (!ours)
         continue;
       snprintf(path, sizeof path, "%s/%s", sub[k], e->d_name);
@@ -251,7 +265,8 @@ static const sph_app_command run_command = {
     "  SIZE (4G, 512M; default 90 % of the memory available) is refused\n",
     run_allowed, NULL, NULL};
 
-/* SIGINT, SIGTERM, SIGHUP: the first asks the run to stop at the next step
+/* SIGINT, SIGTERM, SIGHUP, SIGUSR1 (which mpirun forwards to the ranks
+ * without ending them): the first asks the run to stop at the next step
  * boundary (outputs finished, a checkpoint, summary.json with stopped_by);
  * a second one ends the process at once. */
 static volatile sig_atomic_t stop_signal;
@@ -273,12 +288,14 @@ static void catch_stop_signals(void) {
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
   sigaction(SIGHUP, &sa, NULL);
+  sigaction(SIGUSR1, &sa, NULL);
 }
 
 static const char *signal_name(int signo) {
   return signo == SIGINT    ? "SIGINT"
          : signo == SIGTERM ? "SIGTERM"
          : signo == SIGHUP  ? "SIGHUP"
+         : signo == SIGUSR1 ? "SIGUSR1"
                             : "a signal";
 }
 
@@ -334,14 +351,6 @@ int sph_cmd_run(int argc, char **argv) {
   if (sim->domain && root)
     view.ps = sph_domain_global(sim->domain);
   const sph_sim *whole = sim->domain ? &view : sim;
-  if (args.resume && sim->domain) {
-    if (root)
-      fprintf(stderr, "sph: --resume does not run over MPI ranks yet; "
-                      "resume without mpirun\n");
-    sph_sim_destroy(sim);
-    sph_scene_destroy(scene);
-    return SPH_EXIT_USAGE;
-  }
   if (args.resume && args.out && strcmp(args.resume, args.out)) {
     fprintf(stderr, "sph: --resume continues in its own folder; drop --out "
                     "or give the same folder\n");
@@ -459,9 +468,8 @@ int sph_cmd_run(int argc, char **argv) {
   }
   st = sph_domain_agree(sim->domain, st, &err);
 
-  /* over MPI ranks a signal ends every rank at once (no checkpoints yet) */
-  if (!sim->domain)
-    catch_stop_signals();
+  /* over MPI ranks every rank catches them; they agree on stopping */
+  catch_stop_signals();
   sph_progress prog;
   sph_progress_start(&prog, scene->t_end, args.quiet || !root);
   double wall0 = sph_wtime();
@@ -474,7 +482,7 @@ int sph_cmd_run(int argc, char **argv) {
   double next_ckpt =
       ckpt > 0.0 ? ckpt * (floor(sim->t / ckpt + 1e-9) + 1.0) : INFINITY;
   while (st == SPH_OK && verdict->stable && sim->t < t_end - eps &&
-         !stop_signal) {
+         !sph_domain_max(sim->domain, stop_signal)) {
     double next = sph_output_time(scene, index);
     st = sph_sim_step(sim, next - sim->t, &err);
     if (st != SPH_OK)
@@ -488,25 +496,28 @@ int sph_cmd_run(int argc, char **argv) {
     if (st == SPH_OK && sim->t >= next_ckpt - eps && sim->t < t_end - eps) {
       /* rows before the checkpoint reach the disk first */
       for (int i = 0; i < nsinks && st == SPH_OK; ++i)
-        if (sinks[i].ops->flush) {
+        if (sinks[i].ops->flush && (root || piece_sink(sim, &sinks[i]))) {
           double t0 = sph_wtime();
           st = sinks[i].ops->flush(&sinks[i], &err);
           sinks[i].seconds += sph_wtime() - t0;
         }
+      st = sph_domain_agree(sim->domain, st, &err);
       if (st == SPH_OK)
         st = sph_checkpoint_write(dir, sim, verdict, index, &err);
       next_ckpt += ckpt * floor((sim->t - next_ckpt) / ckpt + 1.0);
     }
   }
   sph_progress_finish(&prog);
-  int stopped = stop_signal;
+  int stopped = (int)sph_domain_max(sim->domain, stop_signal);
   if (stopped && st == SPH_OK && sim->t < t_end - eps) {
     /* stopped between steps: what was written reaches the disk, then a
      * checkpoint to --resume from */
     for (int i = 0; i < nsinks && st == SPH_OK; ++i)
-      if (sinks[i].ops->flush)
+      if (sinks[i].ops->flush && (root || piece_sink(sim, &sinks[i])))
         st = sinks[i].ops->flush(&sinks[i], &err);
-    if (st == SPH_OK)
+    st = sph_domain_agree(sim->domain, st, &err);
+    /* (ranks whose particles migrate stop without one, not written yet) */
+    if (st == SPH_OK && !sph_domain_migrates(sim->domain))
       st = sph_checkpoint_write(dir, sim, verdict, index, &err);
   } else {
     stopped = 0;

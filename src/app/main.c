@@ -306,11 +306,13 @@ int main(int argc, char **argv) {
     return SPH_EXIT_USAGE;
   }
   int rc;
-  if (sph_domain_world_size() > 1 && (argc < 2 || strcmp(argv[1], "run"))) {
+  if (sph_domain_world_size() > 1 &&
+      (argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "bench")))) {
     if (sph_domain_world_rank() == 0)
       fprintf(stderr,
-              "sph: only 'sph run' works over MPI ranks (started "
-              "with %d); run other commands without mpirun\n",
+              "sph: only 'sph run' works over MPI ranks (and 'sph bench "
+              "--mpi'; started with %d); run other commands without "
+              "mpirun\n",
               sph_domain_world_size());
     rc = SPH_EXIT_USAGE;
   } else {

@@ -38,6 +38,7 @@ static const struct option all_options[] = {
     {"max-memory", required_argument, NULL, SPH_OPT_MAX_MEMORY},
     {"resolved", no_argument, NULL, SPH_OPT_RESOLVED},
     {"case", required_argument, NULL, SPH_OPT_CASE},
+    {"mpi", no_argument, NULL, SPH_OPT_MPI},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 

@@ -1,6 +1,10 @@
 /* Checkpoint files (layout in include/sph/checkpoint.h): written through
  * an atomic temporary file with a zlib CRC-32 over every byte, read whole
- * and checked before anything of the simulation is touched. */
+ * and checked before anything of the simulation is touched. Over MPI ranks
+ * every rank writes its owned particles' state as a piece in that layout
+ * and rank 0 then a text manifest naming the pieces with their sizes and
+ * checksums, alternating between two slots so the newest complete
+ * checkpoint is never overwritten. */
 #include <errno.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -10,6 +14,7 @@
 #include <zlib.h>
 
 #include "sph/checkpoint.h"
+#include "sph/domain.h"
 #include "sph/node.h"
 #include "sph/reference.h"
 #include "sph/sink.h"
@@ -97,11 +102,13 @@ sph_status sph_checkpoint_scene_crc(const sph_scene *s, unsigned *crc,
 typedef struct writer {
   FILE *f;
   uLong crc;
+  uint64_t bytes;
 } writer;
 
 static void put(writer *w, const void *p, size_t len) {
   const unsigned char *b = p;
   w->crc = crc32(w->crc, b, (uInt)len);
+  w->bytes += len;
   fwrite(b, 1, len, w->f);
 }
 
@@ -145,20 +152,25 @@ static void put_calls(writer *w, const sph_sim *sim) {
   }
 }
 
-sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
-                                const sph_verdict *v, int next_output,
-                                sph_error *err) {
+/* A piece's identity in its manifest: its length and its stored CRC-32. */
+typedef struct piece_sum {
+  uint64_t size;
+  uint32_t crc;
+} piece_sum;
+
+/* Writes one checkpoint file at path (prev: where the one before is kept,
+ * or NULL); *sum receives its length and checksum. */
+static sph_status write_file(const char *path, const char *prev,
+                             const sph_sim *sim, const sph_verdict *v,
+                             int next_output, piece_sum *sum, sph_error *err) {
   unsigned crc = 0;
   SPH_TRY(sph_checkpoint_scene_crc(sim->scene, &crc, err));
   sph_state_array arr[SPH_MAX_STATE + 1];
   int na = sim->method->state((sph_sim *)sim, arr);
   na += sph_reference_state(sim->reference, arr + na);
-  char path[1024], prev[1100];
-  snprintf(path, sizeof path, "%s/%s", dir, SPH_CHECKPOINT_FILE);
-  snprintf(prev, sizeof prev, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS);
   sph_atomic_file af;
   SPH_TRY(sph_atomic_open(&af, path, err));
-  writer w = {af.f, crc32(0L, Z_NULL, 0)};
+  writer w = {af.f, crc32(0L, Z_NULL, 0), 0};
   header h;
   make_header(sim, next_output, crc, &h);
   put_header(&w, &h);
@@ -176,10 +188,12 @@ sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
   }
   for (int i = 0; i < na; ++i)
     put(&w, arr[i].data, arr[i].len * sizeof(double));
-  uint32_t sum = (uint32_t)w.crc;
-  fwrite(&sum, 4, 1, af.f);
+  uint32_t check = (uint32_t)w.crc;
+  fwrite(&check, 4, 1, af.f);
+  sum->size = w.bytes + 4;
+  sum->crc = check;
   /* keep the last good one until the new one is in place */
-  if (rename(path, prev) != 0 && errno != ENOENT) {
+  if (prev && rename(path, prev) != 0 && errno != ENOENT) {
     sph_atomic_abort(&af);
     return sph_error_at(err, SPH_ERR_IO, prev, 0, 0, NULL,
                         "cannot keep the previous checkpoint: %s",
@@ -189,6 +203,183 @@ sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
   if (st != SPH_OK)
     sph_atomic_abort(&af);
   return st;
+}
+
+/* ---- manifests of runs over MPI ranks -------------------------------- */
+
+static const char slot_name[2] = {'a', 'b'};
+
+static void manifest_path(char *out, size_t len, const char *dir, int slot) {
+  snprintf(out, len, "%s/checkpoint_%c.sphm", dir, slot_name[slot]);
+}
+
+static void piece_name(char *out, size_t len, int slot, int rank) {
+  snprintf(out, len, "checkpoint_%c_p%d.sphc", slot_name[slot], rank);
+}
+
+/* What a manifest says: the rank count, the step and time, and the entry
+ * of one rank's piece. */
+typedef struct manifest {
+  int ranks;
+  unsigned long long step;
+  double t;
+  char scene[64], method[32];
+  piece_sum mine;
+  int have_mine;
+} manifest;
+
+/* Reads a manifest: its own CRC-32 line must hold; fills m with the
+ * entry of `rank`. */
+static sph_status manifest_read(const char *path, int rank, manifest *m,
+                                sph_error *err) {
+  memset(m, 0, sizeof *m);
+  FILE *f = fopen(path, "r");
+  if (!f)
+    return sph_error_set(err, SPH_ERR_IO, "cannot open: %s", strerror(errno));
+  char line[256];
+  uLong crc = crc32(0L, Z_NULL, 0);
+  int sealed = 0, ok = 1, version = 0;
+  unsigned long stored = 0;
+  while (ok && !sealed && fgets(line, sizeof line, f)) {
+    if (sscanf(line, "crc %lx", &stored) == 1) {
+      sealed = 1;
+      break;
+    }
+    crc = crc32(crc, (const Bytef *)line, (uInt)strlen(line));
+    int r;
+    unsigned long long size;
+    unsigned long pc;
+    char name[64];
+    if (line[0] == '#')
+      continue;
+    if (sscanf(line, "manifest %d", &version) == 1 ||
+        sscanf(line, "scene %63s", m->scene) == 1 ||
+        sscanf(line, "method %31s", m->method) == 1 ||
+        sscanf(line, "ranks %d", &m->ranks) == 1 ||
+        sscanf(line, "step %llu", &m->step) == 1 ||
+        sscanf(line, "time %lg", &m->t) == 1)
+      continue;
+    if (sscanf(line, "piece %d %63s %llu %lx", &r, name, &size, &pc) == 4) {
+      if (r == rank) {
+        m->mine = (piece_sum){size, (uint32_t)pc};
+        m->have_mine = 1;
+      }
+      continue;
+    }
+    ok = 0;
+  }
+  fclose(f);
+  if (!sealed || !ok || (uint32_t)stored != (uint32_t)crc)
+    return sph_error_set(err, SPH_ERR_IO,
+                         "incomplete or damaged (its checksum line does "
+                         "not hold)");
+  if (version != 1 || m->ranks < 1)
+    return sph_error_set(err, SPH_ERR_IO, "not a manifest this sph reads");
+  return SPH_OK;
+}
+
+/* Rank 0: the manifest after every piece is in place. */
+static sph_status manifest_write(const char *dir, int slot, const sph_sim *sim,
+                                 const piece_sum *sums, int ranks,
+                                 sph_error *err) {
+  char path[1100], name[64];
+  manifest_path(path, sizeof path, dir, slot);
+  sph_atomic_file af;
+  SPH_TRY(sph_atomic_open(&af, path, err));
+  char *text = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&text, &len);
+  if (!f) {
+    sph_atomic_abort(&af);
+    return sph_error_set(err, SPH_ERR_NOMEM, "checkpoint manifest");
+  }
+  fprintf(f,
+          "# sph checkpoint over %d MPI ranks: one piece per rank, complete "
+          "when this file ends with its crc\nmanifest 1\nscene %s\nmethod "
+          "%s\nranks %d\nstep %lu\ntime %.17g\n",
+          ranks, sim->scene->name, sim->method->name, ranks, sim->steps,
+          sim->t);
+  for (int r = 0; r < ranks; ++r) {
+    piece_name(name, sizeof name, slot, r);
+    fprintf(f, "piece %d %s %llu %08lx\n", r, name,
+            (unsigned long long)sums[r].size, (unsigned long)sums[r].crc);
+  }
+  fclose(f);
+  fwrite(text, 1, len, af.f);
+  fprintf(af.f, "crc %08lx\n",
+          (unsigned long)crc32(crc32(0L, Z_NULL, 0), (const Bytef *)text,
+                               (uInt)len));
+  free(text);
+  sph_status st = sph_atomic_commit(&af, err);
+  if (st != SPH_OK)
+    sph_atomic_abort(&af);
+  return st;
+}
+
+/* Rank 0: the slot to write, the one not holding the newest complete
+ * checkpoint; its manifest is removed before any piece is rewritten. */
+static int slot_to_write(const char *dir) {
+  manifest m[2];
+  int valid[2];
+  for (int s = 0; s < 2; ++s) {
+    char path[1100];
+    manifest_path(path, sizeof path, dir, s);
+    valid[s] = manifest_read(path, 0, &m[s], NULL) == SPH_OK;
+  }
+  int newest = valid[0] && (!valid[1] || m[0].step >= m[1].step) ? 0
+               : valid[1]                                        ? 1
+                                                                 : -1;
+  return newest == 0 ? 1 : 0;
+}
+
+static sph_status write_distributed(const char *dir, const sph_sim *sim,
+                                    const sph_verdict *v, int next_output,
+                                    sph_error *err) {
+  sph_domain *d = sim->domain;
+  int rank = sph_domain_rank(d), ranks = sph_domain_size(d), slot = 0;
+  char path[1100], name[64];
+  if (rank == 0) {
+    slot = slot_to_write(dir);
+    manifest_path(path, sizeof path, dir, slot);
+    remove(path);
+  }
+  slot = sph_domain_bcast_int(d, slot);
+  piece_name(name, sizeof name, slot, rank);
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  piece_sum mine = {0, 0};
+  sph_status st = write_file(path, NULL, sim, v, next_output, &mine, err);
+  SPH_TRY(sph_domain_agree(d, st, err));
+  /* every piece in place: rank 0 names them */
+  uint64_t two[2] = {mine.size, mine.crc}, *all = NULL;
+  piece_sum *sums = NULL;
+  if (rank == 0) {
+    all = malloc(2 * (size_t)ranks * sizeof *all);
+    sums = malloc((size_t)ranks * sizeof *sums);
+    if (!all || !sums)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "checkpoint manifest");
+  }
+  st = sph_domain_agree(d, st, err);
+  if (st == SPH_OK)
+    sph_domain_gather_u64(d, two, 2, all);
+  for (int r = 0; st == SPH_OK && rank == 0 && r < ranks; ++r)
+    sums[r] = (piece_sum){all[2 * r], (uint32_t)all[2 * r + 1]};
+  if (st == SPH_OK && rank == 0)
+    st = manifest_write(dir, slot, sim, sums, ranks, err);
+  free(all);
+  free(sums);
+  return sph_domain_agree(d, st, err);
+}
+
+sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
+                                const sph_verdict *v, int next_output,
+                                sph_error *err) {
+  if (sim->domain)
+    return write_distributed(dir, sim, v, next_output, err);
+  char path[1024], prev[1100];
+  snprintf(path, sizeof path, "%s/%s", dir, SPH_CHECKPOINT_FILE);
+  snprintf(prev, sizeof prev, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS);
+  piece_sum sum;
+  return write_file(path, prev, sim, v, next_output, &sum, err);
 }
 
 /* ---- reading
@@ -207,9 +398,18 @@ static int get(reader *r, void *out, size_t len) {
   return 1;
 }
 
-/* Checks one file against the simulation; on success copies it in. */
-static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
-                       int *next_output, sph_error *err) {
+/* What a file holds besides the state arrays. */
+typedef struct loaded {
+  header h;
+  sph_verdict v;
+  uint64_t calls[SPH_MAX_TIMERS + SPH_MAX_TERMS];
+} loaded;
+
+/* Checks one file against the simulation (and, for a piece of a run over
+ * MPI ranks, against its manifest m); on success copies the state arrays
+ * in and the rest into *out (the verdict over a copy of v). */
+static sph_status load(const char *path, const manifest *m, sph_sim *sim,
+                       const sph_verdict *v, loaded *out, sph_error *err) {
   FILE *f = fopen(path, "rb");
   if (!f)
     return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL, "cannot open: %s",
@@ -248,9 +448,15 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
   memcpy(&sum, buf + len - 4, 4);
   if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), buf, (uInt)(len - 4)) != sum)
     FAIL("checksum mismatch: the file is damaged or truncated");
+  if (m && (len != m->mine.size || sum != m->mine.crc))
+    FAIL("not the piece its manifest names (%zu bytes, checksum %08lx; the "
+         "manifest: %llu bytes, %08lx): left by another checkpoint",
+         len, (unsigned long)sum, (unsigned long long)m->mine.size,
+         (unsigned long)m->mine.crc);
   reader r = {buf, len - 4, sizeof magic};
   uint32_t version = 0, tag = 0, na = 0;
   header h;
+  memset(out, 0, sizeof *out);
   memset(&h, 0, sizeof h);
   if (!get(&r, &version, 4) || !get(&r, &tag, 4))
     FAIL("truncated header");
@@ -271,8 +477,9 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
   if (strcmp(h.method, sim->method->name))
     FAIL("written by method %s, not %s", h.method, sim->method->name);
   if (h.particles != sim->ps->n)
-    FAIL("holds %llu particles, the scene makes %zu",
-         (unsigned long long)h.particles, sim->ps->n);
+    FAIL("holds %llu particles, the scene makes %zu%s",
+         (unsigned long long)h.particles, sim->ps->n,
+         m ? " for this rank" : "");
   if (h.scene_crc != crc)
     FAIL("written for a different configuration of scene '%s' (its "
          "resolved settings differ; resume with the same scene and --set "
@@ -280,13 +487,16 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
          h.scene);
   if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1)
     FAIL("time %g or output index %d out of range", h.t, h.next_output);
+  if (m && (h.t != m->t || h.steps != m->step))
+    FAIL("at step %llu, its manifest at step %llu", (unsigned long long)h.steps,
+         m->step);
   sph_verdict vv = *v;
   for (size_t i = 0; i < NVERDICT; ++i)
     if (!get(&r, (char *)&vv + verdict_fields[i].off, verdict_fields[i].size))
       FAIL("truncated verdict");
   vv.reason[sizeof vv.reason - 1] = '\0';
   uint32_t ncalls = 0;
-  uint64_t calls[SPH_MAX_TIMERS + SPH_MAX_TERMS];
+  uint64_t *calls = out->calls;
   if (!get(&r, &ncalls, 4))
     FAIL("truncated call counts");
   if (ncalls != (uint32_t)(sim->ntimers + sim->nterms))
@@ -317,29 +527,117 @@ static sph_status load(const char *path, sph_sim *sim, sph_verdict *v,
   /* everything checked: copy in */
   for (int i = 0; i < nm; ++i)
     get(&r, arr[i].data, arr[i].len * sizeof(double));
-  if (sim->method->restore && (st = sim->method->restore(sim, err)) != SPH_OK)
-    goto done;
-  /* after restore, which may count a rebuild of its own */
-  for (int i = 0; i < sim->ntimers; ++i)
-    sim->timers[i].calls = (unsigned long)calls[i];
-  for (int i = 0; i < sim->nterms; ++i)
-    sim->terms[i].calls = (unsigned long)calls[sim->ntimers + i];
-  sim->t = h.t;
-  sim->steps = (unsigned long)h.steps;
-  sim->dt_min = h.dt_min;
-  sim->dt_max = h.dt_max;
-  sim->dt_last = h.dt_last;
-  *next_output = h.next_output;
-  *v = vv;
+  out->h = h;
+  out->v = vv;
 #undef FAIL
 done:
   free(buf);
   return st;
 }
 
+/* After a load (on every rank: the method's rebuild may exchange halos):
+ * what the method derives from its state, then counters, time and verdict. */
+static sph_status apply(sph_sim *sim, const loaded *l, sph_verdict *v,
+                        int *next_output, sph_error *err) {
+  if (sim->method->restore)
+    SPH_TRY(sim->method->restore(sim, err));
+  /* after restore, which may count a rebuild of its own */
+  for (int i = 0; i < sim->ntimers; ++i)
+    sim->timers[i].calls = (unsigned long)l->calls[i];
+  for (int i = 0; i < sim->nterms; ++i)
+    sim->terms[i].calls = (unsigned long)l->calls[sim->ntimers + i];
+  sim->t = l->h.t;
+  sim->steps = (unsigned long)l->h.steps;
+  sim->dt_min = l->h.dt_min;
+  sim->dt_max = l->h.dt_max;
+  sim->dt_last = l->h.dt_last;
+  *next_output = l->h.next_output;
+  *v = l->v;
+  return SPH_OK;
+}
+
+/* Over MPI ranks: the newest manifest whose every piece loads, tried on
+ * every rank in the order rank 0 finds them. */
+static sph_status resume_distributed(const char *dir, sph_sim *sim,
+                                     sph_verdict *v, int *next_output,
+                                     char *used, size_t used_len,
+                                     sph_error *err) {
+  sph_domain *d = sim->domain;
+  int rank = sph_domain_rank(d), ranks = sph_domain_size(d), order = 0;
+  if (sph_domain_migrates(d))
+    return sph_error_at(err, SPH_ERR_UNSUPPORTED, dir, 0, 0, NULL,
+                        "%s over MPI ranks writes no checkpoint yet (its "
+                        "particles migrate between ranks): nothing to "
+                        "resume",
+                        sim->method->name);
+  char why[2][320] = {"", ""}, mpath[1100], piece[64], ppath[1200];
+  if (rank == 0) { /* slots newest first, as digits base 3 (0: none) */
+    manifest m[2];
+    int ok[2];
+    for (int s = 0; s < 2; ++s) {
+      sph_error e;
+      manifest_path(mpath, sizeof mpath, dir, s);
+      ok[s] = manifest_read(mpath, 0, &m[s], &e) == SPH_OK;
+      if (!ok[s])
+        snprintf(why[s], sizeof why[s], "%.300s", e.message);
+    }
+    int first = ok[0] && (!ok[1] || m[0].step >= m[1].step) ? 0
+                : ok[1]                                     ? 1
+                                                            : -1;
+    int second = first >= 0 && ok[1 - first] ? 1 - first : -1;
+    order = first + 1 + 3 * (second + 1);
+  }
+  order = sph_domain_bcast_int(d, order);
+  int cand[2] = {order % 3 - 1, order / 3 - 1};
+  for (int k = 0; k < 2 && cand[k] >= 0; ++k) {
+    int s = cand[k];
+    manifest m;
+    sph_error e;
+    sph_error_clear(&e);
+    manifest_path(mpath, sizeof mpath, dir, s);
+    piece_name(piece, sizeof piece, s, rank);
+    snprintf(ppath, sizeof ppath, "%s/%s", dir, piece);
+    sph_status st = manifest_read(mpath, rank, &m, &e);
+    if (st == SPH_OK && m.ranks != ranks)
+      st = sph_error_set(&e, SPH_ERR_IO,
+                         "written by %d MPI ranks, this run has %d: resume "
+                         "with mpirun -np %d",
+                         m.ranks, ranks, m.ranks);
+    else if (st == SPH_OK && !m.have_mine)
+      st = sph_error_set(&e, SPH_ERR_IO, "names no piece of rank %d", rank);
+    loaded l;
+    if (st == SPH_OK && (st = load(ppath, &m, sim, v, &l, &e))) {
+      char msg[sizeof e.message];
+      snprintf(msg, sizeof msg, "%s", e.message);
+      sph_error_set(&e, st, "%s: %.600s", piece, msg);
+    }
+    if (sph_domain_agree(d, st, &e) == SPH_OK) {
+      snprintf(used, used_len, "%s", mpath);
+      st = apply(sim, &l, v, next_output, err);
+      return sph_domain_agree(d, st, err);
+    }
+    snprintf(why[s], sizeof why[s], "%.300s", e.message);
+  }
+  char serial[1100];
+  snprintf(serial, sizeof serial, "%s/%s", dir, SPH_CHECKPOINT_FILE);
+  FILE *f = fopen(serial, "rb");
+  if (f)
+    fclose(f);
+  return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
+                      "no valid checkpoint of %d MPI ranks to resume from "
+                      "(checkpoint_a.sphm: %s; checkpoint_b.sphm: %s)%s",
+                      ranks, why[0], why[1],
+                      f ? "; the folder holds the checkpoint of a run "
+                          "without MPI (" SPH_CHECKPOINT_FILE
+                          "): resume it without mpirun"
+                        : "");
+}
+
 sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
                                  int *next_output, char *used, size_t used_len,
                                  sph_error *err) {
+  if (sim->domain)
+    return resume_distributed(dir, sim, v, next_output, used, used_len, err);
   static const char *const names[] = {SPH_CHECKPOINT_FILE,
                                       SPH_CHECKPOINT_PREVIOUS};
   char why[2][900];
@@ -348,11 +646,26 @@ sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
     snprintf(path, sizeof path, "%s/%s", dir, names[i]);
     sph_error e;
     sph_error_clear(&e);
-    if (load(path, sim, v, next_output, &e) == SPH_OK) {
+    loaded l;
+    if (load(path, NULL, sim, v, &l, &e) == SPH_OK &&
+        apply(sim, &l, v, next_output, &e) == SPH_OK) {
       snprintf(used, used_len, "%s", path);
       return SPH_OK;
     }
     snprintf(why[i], sizeof why[i], "%s: %.800s", names[i], e.message);
+  }
+  /* a checkpoint written over MPI ranks resumes only over as many */
+  for (int s = 0; s < 2; ++s) {
+    char mpath[1100];
+    manifest m;
+    manifest_path(mpath, sizeof mpath, dir, s);
+    if (manifest_read(mpath, 0, &m, NULL) == SPH_OK)
+      return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
+                          "no checkpoint of a run without MPI to resume "
+                          "from (%.200s; %.200s); the folder holds one of "
+                          "%d MPI ranks (checkpoint_%c.sphm): resume with "
+                          "mpirun -np %d",
+                          why[0], why[1], m.ranks, slot_name[s], m.ranks);
   }
   return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
                       "no valid checkpoint to resume from (%.360s; %.360s)",

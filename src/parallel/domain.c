@@ -67,11 +67,16 @@ int sph_domain_world_size(void) { return world_size; }
 int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
 double sph_domain_seconds(const sph_domain *d) { return d ? d->seconds : 0.0; }
 int sph_domain_size(const sph_domain *d) { return d ? d->size : 1; }
+void sph_domain_traffic(const sph_domain *d, double *values, double *messages) {
+  *values = d ? d->sent : 0.0;
+  *messages = d ? d->messages : 0.0;
+}
 size_t sph_domain_ghosts(const sph_domain *d) { return d ? d->ng : 0; }
 const double *sph_domain_ghost_X(const sph_domain *d) { return d->gX; }
 const double *sph_domain_ghost_volume(const sph_domain *d) { return d->gV; }
 const int32_t *sph_domain_ghost_body(const sph_domain *d) { return d->gbody; }
 const int64_t *sph_domain_ghost_id(const sph_domain *d) { return d->gid; }
+int sph_domain_migrates(const sph_domain *d) { return d && d->dyn; }
 sph_particles *sph_domain_global(const sph_domain *d) {
   return d ? d->all : NULL;
 }
@@ -484,9 +489,12 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
     memcpy(d->buf + nc * (size_t)k, field + nc * (size_t)d->send_idx[k],
            nc * sizeof(double));
   for (int q = 0; q < d->size; ++q)
-    if (d->send_count[q])
+    if (d->send_count[q]) {
       MPI_Isend(d->buf + nc * (size_t)d->send_off[q], ncomp * d->send_count[q],
                 MPI_DOUBLE, q, 7, MPI_COMM_WORLD, &req[nr++]);
+      d->sent += (double)(ncomp * d->send_count[q]);
+      d->messages += 1.0;
+    }
   int rc = MPI_Waitall(nr, req, MPI_STATUSES_IGNORE);
   d->seconds += MPI_Wtime() - t0;
   if (rc != MPI_SUCCESS)
@@ -530,6 +538,13 @@ int sph_domain_bcast_int(sph_domain *d, int v) {
   if (d)
     MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
   return v;
+}
+
+void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
+                           uint64_t *out) {
+  if (d)
+    MPI_Gather(v, count, MPI_UINT64_T, out, count, MPI_UINT64_T, 0,
+               MPI_COMM_WORLD);
 }
 
 sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
@@ -620,6 +635,10 @@ void sph_domain_sum(sph_domain *d, double *v, int count) {
   (void)d, (void)v, (void)count;
 }
 int sph_domain_bcast_int(sph_domain *d, int v) { return (void)d, v; }
+void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
+                           uint64_t *out) {
+  (void)d, (void)v, (void)count, (void)out;
+}
 sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   (void)d, (void)err;
   return st;

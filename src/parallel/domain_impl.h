@@ -31,6 +31,7 @@ struct sph_domain {
   double *gbuf;             /* rank 0: 9 per particle, gathered */
   int *counts, *offs;       /* rank 0: per-gather counts and offsets */
   double seconds;           /* in exchanges, reductions and gathers */
+  double sent, messages;    /* doubles and messages the exchanges sent */
   double *sums;             /* 16 per rank: sph_domain_sum's gather */
   sph_domain_dyn *dyn;      /* updated-Lagrangian runs, else NULL */
 };

@@ -147,12 +147,15 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     return sph_node_error(s->root, err, SPH_ERR_UNSUPPORTED,
                           "a scene reference (initial state) does not run "
                           "over MPI ranks yet; run without mpirun");
-  if (s->output.checkpoint_every > 0.0) {
+  if (s->output.checkpoint_every > 0.0 &&
+      sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
     const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;
     return sph_node_error(ck ? ck : s->root, err, SPH_ERR_UNSUPPORTED,
-                          "checkpoints are not written over MPI ranks yet; "
+                          "checkpoints over MPI ranks are not written yet "
+                          "for %s, whose particles migrate between ranks; "
                           "drop output.checkpoint_every or run without "
-                          "mpirun");
+                          "mpirun",
+                          sim->method->name);
   }
   if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
     return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);

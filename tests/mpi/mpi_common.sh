@@ -3,7 +3,8 @@
 # failures (summary prints them and fails on any), the mpirun command line
 # (one thread a rank, oversubscribed; as root allowed), same_bytes A B (two
 # runs' files equal but for the timings) and refused SPH_ARGS... (exit 2 on
-# every rank of ${np:-2}, no folder made, the message $expect).
+# every rank of ${np:-2}, no folder made, the message $expect); fail MESSAGE
+# counts a failure found without check.
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
@@ -20,6 +21,7 @@ check() { # name, command...
     fails=$((fails + 1))
   fi
 }
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1)
 [ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
 same_bytes() { # run folder, run folder

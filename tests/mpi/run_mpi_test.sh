@@ -46,9 +46,6 @@ check "symmetry planes refused" refused run swinging_cube --quiet \
 expect="more than useful"
 np=4 check "too many ranks refused" refused run twisting_column --quiet \
   --set 'method={name: tl-csph}' --set 'bodies.0.particles.count=[3,7,3]'
-expect="checkpoints are not written over MPI"
-check "checkpoints refused" refused run twisting_column --quiet \
-  --set 'method={name: tl-csph}' --set output.checkpoint_every=0.01
 check_other() {
   "${mpi[@]}" -np 2 "$sph" check twisting_column >"$work/ref.txt" 2>&1
   [ $? -eq 2 ] && grep -q "only 'sph run' works over MPI" "$work/ref.txt"

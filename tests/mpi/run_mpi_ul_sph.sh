@@ -57,4 +57,9 @@ done
 plate_moved() { grep -Eq '"migrated": [1-9]' "$work/plate4/summary.json"; }
 check "plate np 4 migrates" plate_moved
 
+# its checkpoints are not written yet: refused before anything is written
+expect="checkpoints over MPI ranks are not written yet for ul-sph"
+check "checkpoints refused" refused "${plate[@]}" \
+  --set output.checkpoint_every=0.001
+
 summary
