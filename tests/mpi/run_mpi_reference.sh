@@ -15,23 +15,16 @@ src=$2
 . "$src/tests/mpi/mpi_common.sh"
 plate=(run oscillating_plate_2d --quiet --set time.end=0.3
   --set 'output.fields=[velocity,displacement,pressure,von_mises,particle_id]')
-OMP_NUM_THREADS=1 "$sph" "${plate[@]}" --out "$work/serial" >/dev/null ||
-  { echo "FAIL plate serial run"; fails=$((fails + 1)); }
-check "plate np 2 runs" "${mpi[@]}" -np 2 "$sph" "${plate[@]}" \
-  --out "$work/np2"
-check "plate np 2 equals serial" /usr/bin/python3 \
-  "$src/tests/mpi/check_mpi.py" "$work/serial" "$work/np2" \
-  oscillating_plate_2d 2 1e-12
-cat "$work/out.txt"
+compare plate oscillating_plate_2d 1e-12 2 -- "${plate[@]}"
 verdict() { # the verdict and the reference's error block of a run
   grep -E '"(stable|error)"' "$1/summary.json"
 }
 same_verdict() {
-  verdict "$work/serial" | grep -q '"period": 0\.2' &&
-    [ "$(verdict "$work/serial")" = "$(verdict "$work/np2")" ]
+  verdict "$work/plate.serial" | grep -q '"period": 0\.2' &&
+    [ "$(verdict "$work/plate.serial")" = "$(verdict "$work/plate.np2")" ]
 }
 check "plate np 2: the serial period and verdict" same_verdict
-verdict "$work/np2"
+verdict "$work/plate.np2"
 
 # refusals: exit 2 on every rank, the folder never made
 expect="an analytic reference (initial state) does not run over MPI ranks yet"
