@@ -244,8 +244,8 @@ static sph_status output_frame(sph_sim *sim, sph_sim *view, sph_sink *sinks,
   }
   if (st == SPH_OK && root)
     st = sph_verdict_observe(v, &whole, err);
-  if (st == SPH_OK && sim->reference)
-    sph_reference_observe(sim->reference, &fr);
+  if (st == SPH_OK && sim->reference && root) /* rank 0: the gathered set */
+    sph_reference_observe(sim->reference, &whole);
   st = sph_domain_agree(sim->domain, st, err);
   v->stable = sph_domain_bcast_int(sim->domain, v->stable);
   return st;

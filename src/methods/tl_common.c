@@ -226,7 +226,10 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
   }
   /* other ranks' particles within a support of ours */
   size_t ng = sph_domain_ghosts(sim->domain);
-  SPH_TRY(grow_points(r, total + ng, &cap, oblique, err));
+  /* an updated-Lagrangian run over ranks holds up to the domain's capacity */
+  size_t hold = sph_domain_capacity(sim->domain, ps);
+  r->cap = total + ng > hold ? total + ng : hold;
+  SPH_TRY(grow_points(r, r->cap, &cap, oblique, err));
   for (size_t g = 0; g < ng; ++g) {
     size_t i = total + g;
     memcpy(r->X + 3 * i, sph_domain_ghost_X(sim->domain) + 3 * g,
@@ -382,7 +385,7 @@ void tl_conservative_force(const tl_reference *ref, double *dp) {
 
 sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
                               double **out, sph_error *err) {
-  *out = calloc(ncomp * ref->n_ext + 1, sizeof **out);
+  *out = calloc(ncomp * ref->cap + 1, sizeof **out);
   return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
 }
 
@@ -419,6 +422,27 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
   return SPH_OK;
 }
 
+sph_status tl_reference_redistribute(tl_reference *ref, sph_sim *sim,
+                                     sph_error *err) {
+  sph_particles *ps = sim->ps;
+  if (!sim->domain || sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
+    return SPH_OK;
+  SPH_TRY(sph_domain_rebuild(sim->domain, ps, sim->kernel.support, err));
+  const sph_scene *s = sim->scene;
+  ref->n = ref->n_img = ps->n;
+  ref->n_ext = ps->n + sph_domain_ghosts(sim->domain);
+  for (size_t a = 0; a < ref->n_ext; ++a) {
+    const sph_body *b = &s->bodies[ps->body[a]];
+    ref->body[a] = ps->body[a];
+    ref->id[a] = ps->id[a];
+    ref->mat[a] = &s->materials[b->material];
+    ref->rho0[a] = ref->mat[a]->density;
+    if (ref->axes)
+      ref->axes[a] = b->transform.given ? b->transform.R : NULL;
+  }
+  return sph_sim_terms_renumber(sim, err);
+}
+
 sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
                                sph_error *err) {
   memset(ref, 0, sizeof *ref);
@@ -432,8 +456,8 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
     sim->mirror = &ref->mirror;
 
   /* per-point material and density, the fastest wave */
-  ref->mat = malloc(ne * sizeof *ref->mat);
-  ref->rho0 = malloc(ne * sizeof *ref->rho0);
+  ref->mat = malloc(ref->cap * sizeof *ref->mat);
+  ref->rho0 = malloc(ref->cap * sizeof *ref->rho0);
   if (!ref->mat || !ref->rho0)
     return sph_error_set(err, SPH_ERR_NOMEM, "materials");
   for (size_t a = 0; a < ne; ++a) {
@@ -447,7 +471,8 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
     placed |= s->bodies[b].transform.given;
   }
   /* the material axes of placed bodies turn with them */
-  if (placed && !(ref->axes = malloc((n ? n : 1) * sizeof *ref->axes)))
+  if (placed &&
+      !(ref->axes = malloc((ref->cap ? ref->cap : 1) * sizeof *ref->axes)))
     return sph_error_set(err, SPH_ERR_NOMEM, "materials");
   for (size_t a = 0; placed && a < n; ++a) {
     const sph_transform *T = &s->bodies[ref->body[a]].transform;
@@ -498,14 +523,14 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   }
   tl_mirror_refresh(ref, ref->x, ref->p, ref->F, NULL, ref->J);
 
-  int64_t *id = malloc(ne * sizeof *id);
+  int64_t *id = malloc(ref->cap * sizeof *id);
   if (!id)
     return sph_error_set(err, SPH_ERR_NOMEM, "ids");
   for (size_t a = 0; a < ne; ++a)
     id[a] = a < ref->n_img ? ps->id[ref->src[a]]
                            : sph_domain_ghost_id(sim->domain)[a - ref->n_img];
   ref->id = id;
-  ref->s = calloc(3 * n + 3, sizeof *ref->s);
+  ref->s = calloc(3 * ref->cap + 3, sizeof *ref->s);
   if (!ref->s)
     return sph_error_set(err, SPH_ERR_NOMEM, "pair weights");
   SPH_TRY(tl_reference_alloc(ref, 9, &ref->L, err));

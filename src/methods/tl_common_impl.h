@@ -31,6 +31,8 @@ typedef struct tl_reference {
   size_t n, n_ext;   /* real particles, real + mirror images + ghosts */
   size_t n_img;      /* real + mirror images; the ghosts of a distributed run
                         (sph_domain) follow, their state set by exchange */
+  size_t cap;        /* points the per-point arrays hold (n_ext, or the
+                        capacity of an updated-Lagrangian run over ranks) */
   double *X;         /* reference positions (3 n_ext) */
   double *V;         /* volumes (n_ext) */
   int32_t *body;     /* bodies (n_ext) */
@@ -72,6 +74,14 @@ void tl_reference_destroy(tl_reference *ref);
  * reference update; w grows only when the pair count exceeds it). */
 sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
                                 sph_error *err);
+
+/* Over MPI ranks with a dynamic domain (else nothing): the rebuild of
+ * sph_domain_rebuild (migration by the current positions, re-balance, the
+ * ghosts found again), then the points' bodies, ids, materials and axes
+ * from the particle set and the terms renumbered. The caller tracks X and
+ * its own per-point arrays (sph_domain_track) and rebuilds the reference. */
+sph_status tl_reference_redistribute(tl_reference *ref, sph_sim *sim,
+                                     sph_error *err);
 
 /* Slot of (b -> a) for every slot (a -> b), for pair quantities that are
  * not antisymmetric (allocated here, freed by the caller). */

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sph/domain.h"
 #include "sph/tensor.h"
 
 typedef enum { REF_SWINGING_CUBE, REF_SWINGING_PLATE, REF_PERIOD } ref_kind;
@@ -229,10 +230,14 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
   sph_particles *ps = sim->ps;
   sph_reference *rw = (sph_reference *)r; /* amplitude found on the set */
   if (r->kind == REF_PERIOD) {
+    /* over MPI ranks rank 0 observes the gathered set (the serial order) */
+    const sph_particles *all =
+        sim->domain ? sph_domain_global(sim->domain) : ps;
+    memset(rw->obs, 0, sizeof rw->obs);
     /* the particle nearest to `at` in the reference configuration */
     double best = INFINITY;
-    for (size_t a = 0; a < ps->n; ++a) {
-      const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+    for (size_t a = 0; all && a < all->n; ++a) {
+      const double *X = all->field[SPH_FIELD_POSITION0] + 3 * a;
       double d = 0.0;
       for (int c = 0; c < 3; ++c)
         d += (X[c] - r->at[c]) * (X[c] - r->at[c]);
@@ -241,9 +246,12 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
         rw->particle = a;
       }
     }
-    memset(rw->obs, 0, sizeof rw->obs);
     return SPH_OK;
   }
+  if (sim->domain)
+    return sph_node_error(sim->scene->reference, err, SPH_ERR_UNSUPPORTED,
+                          "an analytic reference (initial state) does not run "
+                          "over MPI ranks yet; run without mpirun");
   SPH_TRY(sph_particles_require(ps, SPH_FIELD_DEFGRAD, err));
   SPH_TRY(sph_particles_require(ps, SPH_FIELD_POSITION, err));
   rw->P_amp = 0.0;

@@ -143,10 +143,6 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                             err, SPH_ERR_UNSUPPORTED,
                             "symmetry planes (mirror images) do not run over "
                             "MPI ranks yet; run without mpirun");
-  if (sim->reference)
-    return sph_node_error(s->root, err, SPH_ERR_UNSUPPORTED,
-                          "a scene reference (initial state) does not run "
-                          "over MPI ranks yet; run without mpirun");
   if (s->output.checkpoint_every > 0.0 &&
       sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
     const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;

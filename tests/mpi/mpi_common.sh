@@ -1,10 +1,13 @@
 # The frame of the MPI test scripts (sourced after `set -u`, with $sph set):
 # a scratch folder removed on exit, check NAME COMMAND... counting checks and
-# failures (summary prints them and fails on any), the mpirun command line
+# failures (summary prints them and fails on any), compare (below), the
+# mpirun command line
 # (one thread a rank, oversubscribed; as root allowed), same_bytes A B (two
 # runs' files equal but for the timings) and refused SPH_ARGS... (exit 2 on
 # every rank of ${np:-2}, no folder made, the message $expect); fail MESSAGE
 # counts a failure found without check.
+# the output fields check_mpi.py compares (particle_id matches the particles)
+fields='output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]'
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0
@@ -42,6 +45,36 @@ refused() { # sph args...
     cat "$work/ref.txt"
     return 1
   fi
+}
+frames_alike() { # serial dir, MPI dir
+  for f in "$1"/frames/*.png; do
+    "$sph" imgdiff "$f" "$2/frames/${f##*/}" || return 1
+  done
+}
+
+# compare NAME SCENE BOUND RANKS... -- SPH_ARGS...: the serial run (one
+# thread), then on each rank count the run and check_mpi.py against it
+# (BOUND: its REL_TOL and options), the frames alike by sph imgdiff
+compare() {
+  local name=$1 scene=$2 bound=$3
+  shift 3
+  local ranks=()
+  while [ "$1" != -- ]; do ranks+=("$1"); shift; done
+  shift
+  OMP_NUM_THREADS=1 "$sph" "$@" --out "$work/$name.serial" >/dev/null ||
+    { echo "FAIL $name serial run"; fails=$((fails + 1)); return; }
+  for n in "${ranks[@]}"; do
+    check "$name np $n runs" "${mpi[@]}" -np "$n" "$sph" "$@" \
+      --out "$work/$name.np$n"
+    check "$name np $n equals serial" /usr/bin/python3 \
+      "$src/tests/mpi/check_mpi.py" "$work/$name.serial" "$work/$name.np$n" \
+      "$scene" "$n" $bound
+    cat "$work/out.txt"
+    if [ -d "$work/$name.serial/frames" ]; then
+      check "$name np $n frames alike" frames_alike "$work/$name.serial" \
+        "$work/$name.np$n"
+    fi
+  done
 }
 summary() {
   echo "$((total - fails)) passed, $fails failed"

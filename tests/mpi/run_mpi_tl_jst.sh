@@ -21,7 +21,6 @@ sph=$1
 src=$2
 # shellcheck source=mpi_common.sh
 . "$src/tests/mpi/mpi_common.sh"
-fields='output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]'
 column=(run twisting_column --quiet --set time.end=0.05 --set output.every=0.01
   --set output.png.width=320 --set output.png.height=180
   --set output.png.mp4=false --set "$fields")
@@ -31,34 +30,6 @@ symmetric=("${column[@]}" --set method.force=symmetric --set time.end=0.02)
 bond=(run twisting_column_bond --quiet --set time.end=0.005
   --set output.every=0.0025 --set output.png.width=320
   --set output.png.height=180 --set output.png.mp4=false --set "$fields")
-frames_alike() { # serial dir, MPI dir
-  for f in "$1"/frames/*.png; do
-    "$sph" imgdiff "$f" "$2/frames/${f##*/}" || return 1
-  done
-}
-
-# name, scene, bound, ranks..., then the run's arguments after --
-compare() {
-  local name=$1 scene=$2 bound=$3
-  shift 3
-  local ranks=()
-  while [ "$1" != -- ]; do ranks+=("$1"); shift; done
-  shift
-  OMP_NUM_THREADS=1 "$sph" "$@" --out "$work/$name.serial" >/dev/null ||
-    { echo "FAIL $name serial run"; fails=$((fails + 1)); return; }
-  for n in "${ranks[@]}"; do
-    check "$name np $n runs" "${mpi[@]}" -np "$n" "$sph" "$@" \
-      --out "$work/$name.np$n"
-    check "$name np $n equals serial to round-off" /usr/bin/python3 \
-      "$src/tests/mpi/check_mpi.py" "$work/$name.serial" "$work/$name.np$n" \
-      "$scene" "$n" $bound
-    cat "$work/out.txt"
-    if [ -d "$work/$name.serial/frames" ]; then
-      check "$name np $n frames alike" frames_alike "$work/$name.serial" \
-        "$work/$name.np$n"
-    fi
-  done
-}
 roundoff="1e-12 --roundoff"
 compare column twisting_column "$roundoff" 2 4 -- "${column[@]}"
 compare punch punch "$roundoff" 2 4 -- "${punch[@]}"

@@ -21,14 +21,19 @@
 #include "terms/terms_impl.h"
 
 /* f (eq. 12-13, stabilised by eq. 17 / 21 when eta > 0), F = f F^r, images
- * mirrored, P, S = P F^r^T / J^r and the force matrices for every point */
-static void deformation_and_stress(ul_csph *m, long n) {
+ * mirrored, ghosts' from their owners, P, S = P F^r^T / J^r and the force
+ * matrices for every point */
+static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
   tl_reference *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
+  sph_domain *dom = m->sim->domain;
   long ne = (long)ref->n_ext;
+  /* a ghost's list is partial: its stabilised force matrix is its owner's */
+  long nq = dom ? (long)ref->n_img : ne;
   int dim = m->sim->scene->dimension, stab = m->eta > 0.0;
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+  SPH_TRY(sph_domain_exchange(dom, m->x, 3, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
@@ -45,6 +50,7 @@ static void deformation_and_stress(ul_csph *m, long n) {
   if (stab) {
     if (ne > n)
       tl_mirror_refresh(ref, m->x, m->p, m->f0, NULL, NULL);
+    SPH_TRY(sph_domain_exchange(dom, m->f0, 9, err));
 #pragma omp parallel for schedule(static)
     for (long a = 0; a < n; ++a) {
       double acc[9] = {0}, f[9];
@@ -62,6 +68,7 @@ static void deformation_and_stress(ul_csph *m, long n) {
   }
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+  SPH_TRY(sph_domain_exchange(dom, m->F, 9, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];
@@ -75,9 +82,9 @@ static void deformation_and_stress(ul_csph *m, long n) {
                            ref->Qt + 9 * a);
   }
   if (!stab)
-    return;
+    return SPH_OK;
 #pragma omp parallel for schedule(static)
-  for (long a = 0; a < ne; ++a) {
+  for (long a = 0; a < nq; ++a) {
     double Y[9] = {0}; /* adjoint of the f0 difference term */
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t j = (size_t)nl->index[k];
@@ -88,6 +95,7 @@ static void deformation_and_stress(ul_csph *m, long n) {
     ul_iact_force_matrix(m->S + 9 * a, Y, m->eta / ref->V[a], ref->L + 9 * a,
                          ref->Qt + 9 * a);
   }
+  return sph_domain_exchange(dom, ref->Qt, 9, err);
 }
 
 /* the Hessian term's share of the force (adjoint of eq. 21's first
@@ -114,7 +122,7 @@ static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
   sph_sim *sim = m->sim;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
-  deformation_and_stress(m, n);
+  SPH_TRY(deformation_and_stress(m, n, err));
   tl_conservative_force(&m->ref, m->dp);
   if (m->eta > 0.0)
     stabilisation_force(m, n);
@@ -158,8 +166,7 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
-    const double *Xa = ref->X + 3 * a;
-    double C[9] = {0}, D[9] = {0}, Dinv[9] = {0}, M[9];
+    double C[9] = {0}, D[9] = {0}, Dinv[9] = {0};
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
       double r[3], d;
@@ -181,7 +188,13 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
     for (int c = dim; c < 3; ++c)
       D[4 * c] = 1.0; /* no moment across the plane of a 2D body */
     sph_mat3_inverse(D, Dinv);
-    sph_mat3_mul(C, Dinv, M);
+    sph_mat3_mul(C, Dinv, m->A + 9 * a);
+  }
+  /* a ghost's A is its owner's (its own list is partial) */
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->A, 9, err));
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    const double *Xa = ref->X + 3 * a, *M = m->A + 9 * a;
     double sv[3] = {0, 0, 0}, sgh = 0.0;
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
@@ -205,17 +218,23 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
   return SPH_OK;
 }
 
-/* V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
+/* over MPI ranks the particles migrate and the ghosts are found again; then
+ * V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
 static sph_status rebuild(ul_csph *m, sph_error *err) {
   tl_reference *ref = &m->ref;
+  SPH_TRY(tl_reference_redistribute(ref, m->sim, err));
+  m->lf.n = ref->n;
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     m->Jr[a] = sph_mat3_det(m->Fr + 9 * a);
     ref->V[a] = m->Jr[a] * m->V0[a];
   }
-  SPH_TRY(tl_reference_rebuild(ref, m->sim, err));
-  return m->eta > 0.0 ? stabilisation_setup(m, err) : SPH_OK;
+  sph_status st = tl_reference_rebuild(ref, m->sim, err);
+  if (st == SPH_OK && m->eta > 0.0)
+    st = stabilisation_setup(m, err);
+  /* every rank learns of a failure before the next exchange */
+  return sph_domain_agree(m->sim->domain, st, err);
 }
 
 /* x^r = x^n and F^r = F^n (seed 001 sec. 3.1, Fig. 8), timed on its own */
@@ -223,7 +242,7 @@ static sph_status reference_update(ul_csph *m, sph_error *err) {
   sph_sim *sim = m->sim;
   tl_reference *ref = &m->ref;
   double t0 = sph_wtime();
-  deformation_and_stress(m, (long)ref->n);
+  SPH_TRY(deformation_and_stress(m, (long)ref->n, err));
   memcpy(ref->X, m->x, 3 * ref->n_ext * sizeof *ref->X);
   memcpy(m->Fr, m->F, 9 * ref->n_ext * sizeof *m->Fr);
   sph_status st = rebuild(m, err);
@@ -241,7 +260,7 @@ static double ul_csph_stable_dt(sph_sim *sim) {
 
 /* the displacement criterion: some particle has moved more than
  * update_distance spacings from its reference position */
-static int moved_beyond(const ul_csph *m) {
+static int moved_beyond(ul_csph *m) {
   const tl_reference *ref = &m->ref;
   long n = (long)ref->n;
   double lim = m->update_distance * m->sim->dp, d2max = 0.0;
@@ -253,7 +272,7 @@ static int moved_beyond(const ul_csph *m) {
     double d2 = sph_vec3_dot(d, d);
     d2max = d2 > d2max ? d2 : d2max;
   }
-  return d2max > lim * lim;
+  return sph_domain_max(m->sim->domain, d2max) > lim * lim;
 }
 
 static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
@@ -266,7 +285,7 @@ static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
 
 static sph_status ul_csph_derive(sph_sim *sim, sph_error *err) {
   ul_csph *m = sim->method_data;
-  deformation_and_stress(m, (long)sim->ps->n);
+  SPH_TRY(deformation_and_stress(m, (long)sim->ps->n, err));
   return tl_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
 }
 
@@ -290,6 +309,7 @@ static void ul_csph_destroy(sph_sim *sim) {
   free(m->rev);
   free(m->sv);
   free(m->sgh);
+  free(m->A);
   free(m->f0);
   free(m->S);
   free(m->dp);
@@ -334,20 +354,20 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "eta must be in [0, 100], got %g", m->eta);
   const sph_scene *s = sim->scene;
   SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
-  sph_particles *ps = sim->ps;
   size_t ne = m->ref.n_ext;
   m->x = m->ref.x;
   m->p = m->ref.p;
   m->F = m->ref.F;
   m->P = m->ref.P;
-  m->dp = calloc(3 * ps->n + 3, sizeof *m->dp);
-  m->V0 = malloc((ne + 1) * sizeof *m->V0);
+  m->dp = calloc(3 * m->ref.cap + 3, sizeof *m->dp);
+  m->V0 = malloc((m->ref.cap + 1) * sizeof *m->V0);
   SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->Fr, err));
   SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->Jr, err));
   SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->S, err));
   SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->f0, err));
   SPH_TRY(tl_reference_alloc(&m->ref, 3, &m->sv, err));
   SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->sgh, err));
+  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->A, err));
   /* h of Remark 2: the smoothing length along each axis of the body */
   for (int c = 0; c < s->dimension; ++c)
     m->h[c] = sim->kernel.h;
@@ -361,6 +381,10 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");
   if (sim->initial_defgrad) /* the given deformed state is x^r */
     memcpy(m->ref.X, m->x, 3 * ne * sizeof *m->ref.X);
+  /* over MPI ranks: what moves with a particle besides the set's fields */
+  SPH_TRY(sph_domain_track(sim->domain, m->ref.X, 3, err));
+  SPH_TRY(sph_domain_track(sim->domain, m->Fr, 9, err));
+  SPH_TRY(sph_domain_track(sim->domain, m->V0, 1, err));
   SPH_TRY(rebuild(m, err));
   return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,
                             ul_csph_constrain, m, err);
@@ -395,6 +419,7 @@ const sph_method_ops ul_csph_method_ops = {
     .title = "Stabilised updated-Lagrangian corrected SPH",
     .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 3-4, eq. 12-21",
     .conserves_angular_momentum = 1,
+    .distributed = SPH_DISTRIBUTED_DYNAMIC,
     .fields = TL_OUTPUT_FIELDS,
     .setup = ul_csph_setup,
     .stable_dt = ul_csph_stable_dt,

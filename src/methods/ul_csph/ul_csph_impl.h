@@ -18,6 +18,7 @@ typedef struct ul_csph {
    * point their sums over the slots (sum_k V_k H~_k h, sum_k g_k.h) */
   double eta, h[3];
   double *hv, *gh, *sv, *sgh;
+  double *A; /* the linear correction of eq. 19 per point (9 n_ext) */
   size_t *rev, slot_cap;
   double *f0, *S;        /* unstabilised f, P F^r^T / J^r (9 n_ext) */
   double *x, *p, *F, *P; /* particle fields */

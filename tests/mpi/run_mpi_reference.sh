@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# A scene's `reference:` over MPI ranks: the oscillating plate (ul-sph, its
+# period measured at the tip against theory) as shipped but for its end time
+# (0.3 s: two zero crossings of the tip, one measured period) and the
+# particle ids in its fields, on 2 ranks: rank 0 observes the tip in the
+# gathered set, so summary.json gives the serial period, error and verdict,
+# and the files are the serial ones (check_mpi.py: fields and probes
+# identical, energies to 1e-12). An analytic reference (it sets the initial
+# state) is refused.
+# Usage: run_mpi_reference.sh SPH SOURCE_DIR
+set -u
+sph=$1
+src=$2
+# shellcheck source=mpi_common.sh
+. "$src/tests/mpi/mpi_common.sh"
+plate=(run oscillating_plate_2d --quiet --set time.end=0.3
+  --set 'output.fields=[velocity,displacement,pressure,von_mises,particle_id]')
+compare plate oscillating_plate_2d 1e-12 2 -- "${plate[@]}"
+verdict() { # the verdict and the reference's error block of a run
+  grep -E '"(stable|error)"' "$1/summary.json"
+}
+same_verdict() {
+  verdict "$work/plate.serial" | grep -q '"period": 0\.2' &&
+    [ "$(verdict "$work/plate.serial")" = "$(verdict "$work/plate.np2")" ]
+}
+check "plate np 2: the serial period and verdict" same_verdict
+verdict "$work/plate.np2"
+
+# refusals: exit 2 on every rank, the folder never made
+expect="an analytic reference (initial state) does not run over MPI ranks yet"
+check "analytic reference refused" refused run twisting_column --quiet \
+  --set 'reference={analytic: swinging_cube}'
+summary
