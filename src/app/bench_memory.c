@@ -3,17 +3,14 @@
  * caches, the best of the repetitions of 0.3 s (at least ten), on a given
  * thread count. A case
  * whose sweeps stream their data from memory cannot gain more from threads
- * than this bandwidth does, so bench prints it beside the cases. It runs in
- * a child process, as the cases do: an OpenMP team started in the parent
- * would not survive the cases' fork. */
+ * than this bandwidth does, so bench prints it beside the cases (from a
+ * child process, as the cases: cmd_bench.c). */
 #include <omp.h>
 #include <stdlib.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "app/app_impl.h"
 
-static double triad(int threads, size_t bytes) {
+double bench_memory_triad(int threads, size_t bytes) {
   long n = (long)(bytes / sizeof(double));
   double *a = malloc((size_t)n * sizeof *a), *b = malloc((size_t)n * sizeof *b),
          *c = malloc((size_t)n * sizeof *c);
@@ -44,24 +41,4 @@ static double triad(int threads, size_t bytes) {
   free(b);
   free(c);
   return best;
-}
-
-double bench_memory_triad(int threads, size_t bytes) {
-  int fd[2];
-  if (pipe(fd) != 0)
-    return 0.0;
-  pid_t pid = fork();
-  if (pid == 0) {
-    close(fd[0]);
-    double rate = triad(threads, bytes);
-    _exit(write(fd[1], &rate, sizeof rate) == (ssize_t)sizeof rate ? 0 : 1);
-  }
-  close(fd[1]);
-  double rate = 0.0;
-  if (pid < 0 || read(fd[0], &rate, sizeof rate) != (ssize_t)sizeof rate)
-    rate = 0.0;
-  close(fd[0]);
-  if (pid > 0)
-    waitpid(pid, NULL, 0);
-  return rate;
 }

@@ -255,10 +255,12 @@ static void bench_child(const bench_case *c, int threads, const char *dir,
   sph_scene_destroy(scene);
 }
 
-/* runs one case in a child process; returns 0, or -1 when it could not */
-static int bench_run(const bench_case *c, int threads, const char *dir,
-                     bench_result *r) {
-  memset(r, 0, sizeof *r);
+/* Runs work(ctx, out) in a child process (an OpenMP team started in this
+ * process would not survive the next fork) and reads its size bytes of
+ * out back; 1 when they all came, 0 when not (status: how the child
+ * ended), -1 when no child could be started. */
+static int in_child(void (*work)(const void *ctx, void *out), const void *ctx,
+                    void *out, size_t size, int *status, struct rusage *ru) {
   int fd[2];
   if (pipe(fd) != 0)
     return -1;
@@ -271,26 +273,46 @@ static int bench_run(const bench_case *c, int threads, const char *dir,
   }
   if (pid == 0) {
     close(fd[0]);
-    bench_result mine;
-    memset(&mine, 0, sizeof mine);
-    bench_child(c, threads, dir, &mine);
-    ssize_t w = write(fd[1], &mine, sizeof mine);
-    _exit(w == (ssize_t)sizeof mine ? 0 : 1);
+    work(ctx, out);
+    ssize_t w = write(fd[1], out, size);
+    _exit(w == (ssize_t)size ? 0 : 1);
   }
   close(fd[1]);
   size_t got = 0;
-  while (got < sizeof *r) {
-    ssize_t k = read(fd[0], (char *)r + got, sizeof *r - got);
+  while (got < size) {
+    ssize_t k = read(fd[0], (char *)out + got, size - got);
     if (k <= 0)
       break;
     got += (size_t)k;
   }
   close(fd[0]);
+  if (wait4(pid, status, 0, ru) < 0)
+    return -1;
+  return got == size;
+}
+
+typedef struct case_job {
+  const bench_case *c;
+  int threads;
+  const char *dir;
+} case_job;
+
+static void case_work(const void *ctx, void *out) {
+  const case_job *j = ctx;
+  bench_child(j->c, j->threads, j->dir, out);
+}
+
+/* runs one case in a child process; returns 0, or -1 when it could not */
+static int bench_run(const bench_case *c, int threads, const char *dir,
+                     bench_result *r) {
+  memset(r, 0, sizeof *r);
+  case_job job = {c, threads, dir};
   int status = 0;
   struct rusage ru;
-  if (wait4(pid, &status, 0, &ru) < 0)
+  int got = in_child(case_work, &job, r, sizeof *r, &status, &ru);
+  if (got < 0)
     return -1;
-  if (got != sizeof *r) {
+  if (!got) {
     memset(r, 0, sizeof *r);
     snprintf(r->error, sizeof r->error, "the case's process ended (%s %d)",
              WIFSIGNALED(status) ? "signal" : "status",
@@ -298,6 +320,26 @@ static int bench_run(const bench_case *c, int threads, const char *dir,
   }
   r->max_rss_kb = ru.ru_maxrss;
   return 0;
+}
+
+typedef struct triad_job {
+  int threads;
+} triad_job;
+
+static void triad_work(const void *ctx, void *out) {
+  const triad_job *j = ctx;
+  *(double *)out = bench_memory_triad(j->threads, (size_t)64 << 20);
+}
+
+/* the STREAM triad on `threads` threads (bytes per second, 0 if it failed) */
+static double triad_rate(int threads) {
+  triad_job job = {threads};
+  double rate = 0.0;
+  int status = 0;
+  struct rusage ru;
+  return in_child(triad_work, &job, &rate, sizeof rate, &status, &ru) == 1
+             ? rate
+             : 0.0;
 }
 
 static double per_thread_rate(const bench_result *r) {
@@ -750,7 +792,7 @@ int sph_cmd_bench(int argc, char **argv) {
   double triad[2] = {0.0, 0.0};
   for (int turn = 0; turn < 3; ++turn)
     for (int t = 0; t < nthr; ++t) {
-      double r = bench_memory_triad(thr[t], (size_t)64 << 20);
+      double r = triad_rate(thr[t]);
       triad[t] = r > triad[t] ? r : triad[t];
     }
   printf("  memory bandwidth (STREAM triad, best of 3 turns): %d thr %.1f GB/s",
