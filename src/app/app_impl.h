@@ -151,7 +151,10 @@ int sph_cmd_bench(int argc, char **argv);
 /* Bytes per second of the STREAM triad over three arrays of `bytes` each on
  * `threads` threads, the best of 0.3 s of repetitions (0 when they cannot be
  * allocated); it starts an OpenMP team, so bench calls it in a child. */
-double bench_memory_triad(int threads, size_t bytes);
+double bench_machine_triad(int threads, size_t bytes);
+/* Flops per second of independent multiply-add chains in registers on
+ * `threads` threads, the best of 0.3 s of repetitions; in a child too. */
+double bench_machine_flops(int threads);
 /* sph render RUN [options]: 0 done, 2 bad input (missing or damaged files),
  * 3 I/O */
 int sph_cmd_render(int argc, char **argv);

@@ -322,22 +322,25 @@ static int bench_run(const bench_case *c, int threads, const char *dir,
   return 0;
 }
 
-typedef struct triad_job {
-  int threads;
-} triad_job;
+typedef struct machine_job {
+  int threads, arithmetic; /* arithmetic: the multiply-add chains */
+} machine_job;
 
-static void triad_work(const void *ctx, void *out) {
-  const triad_job *j = ctx;
-  *(double *)out = bench_memory_triad(j->threads, (size_t)64 << 20);
+static void machine_work(const void *ctx, void *out) {
+  const machine_job *j = ctx;
+  *(double *)out = j->arithmetic
+                       ? bench_machine_flops(j->threads)
+                       : bench_machine_triad(j->threads, (size_t)64 << 20);
 }
 
-/* the STREAM triad on `threads` threads (bytes per second, 0 if it failed) */
-static double triad_rate(int threads) {
-  triad_job job = {threads};
+/* the STREAM triad (bytes per second) or the multiply-add chains (flops per
+ * second) on `threads` threads; 0 if it failed */
+static double machine_rate(int threads, int arithmetic) {
+  machine_job job = {threads, arithmetic};
   double rate = 0.0;
   int status = 0;
   struct rusage ru;
-  return in_child(triad_work, &job, &rate, sizeof rate, &status, &ru) == 1
+  return in_child(machine_work, &job, &rate, sizeof rate, &status, &ru) == 1
              ? rate
              : 0.0;
 }
@@ -429,19 +432,24 @@ static void cpu_model(char *out, size_t len) {
 }
 
 /* the JSON's opening: schema, suite and machine */
-/* the head and the machine; triad: the memory bandwidth on ntriad thread
- * counts (none: ntriad 0) */
+/* the head and the machine; speed[0][t]: the memory bandwidth, speed[1][t]
+ * the arithmetic rate on the bench's nthr thread counts (none: nthr 0) */
 static void json_head(FILE *f, const char *suite, long cores,
-                      const double *triad, int ntriad) {
+                      const double speed[2][2], int nthr) {
   char cpu[256];
   cpu_model(cpu, sizeof cpu);
   fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
           BENCH_SCHEMA, suite);
   fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
   json_str(f, cpu);
-  for (int t = 0; t < ntriad; ++t)
-    fprintf(f, "%s%.4g", t ? ", " : ", \"triad_gb_per_s\": [", triad[t] / 1e9);
-  fprintf(f, "%s},\n", ntriad ? "]" : "");
+  const char *keys[2] = {"triad_gb_per_s", "multiply_add_gflop_per_s"};
+  for (int k = 0; k < 2 && nthr > 0; ++k) {
+    fprintf(f, ", \"%s\": [", keys[k]);
+    for (int t = 0; t < nthr; ++t)
+      fprintf(f, "%s%.4g", t ? ", " : "", speed[k][t] / 1e9);
+    fprintf(f, "]");
+  }
+  fprintf(f, "},\n");
 }
 
 /* closes the JSON written to tmp and renames it to path; -1 on failure */
@@ -458,13 +466,13 @@ static int json_finish(FILE *f, const char *tmp, const char *path) {
 
 static int write_json(const char *path, const bench_case *cases, int ncases,
                       const bench_result *res, int nthr, int quick, long cores,
-                      long baseline_kb, const double triad[2]) {
+                      long baseline_kb, const double speed[2][2]) {
   char tmp[1100];
   snprintf(tmp, sizeof tmp, "%s.part", path);
   FILE *f = fopen(tmp, "w");
   if (!f)
     return -1;
-  json_head(f, quick ? "quick" : "full", cores, triad, nthr);
+  json_head(f, quick ? "quick" : "full", cores, speed, nthr);
   fprintf(f, "  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
           baseline_kb / 1024.0);
   for (int c = 0; c < ncases; ++c)
@@ -786,22 +794,31 @@ int sph_cmd_bench(int argc, char **argv) {
   printf("sph bench (%s suite): %ld cores, threads %d%s; baseline "
          "resident set %.0f MB\n",
          quick ? "quick" : "full", cores, thr[0], thr2, baseline_kb / 1024.0);
-  /* the memory system's own speed-up with threads: the ceiling of a case
-   * that streams its data (3 arrays of 64 MB, beyond any cache), the best
-   * of three turns in alternation, as a shared machine's load comes and goes */
-  double triad[2] = {0.0, 0.0};
+  /* the machine's own speed-up with threads: the ceilings of a case that
+   * streams its data (3 arrays of 64 MB, beyond any cache) and of one bound
+   * by arithmetic, the best of three turns in alternation, as a shared
+   * machine's load comes and goes */
+  double speed[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
   for (int turn = 0; turn < 3; ++turn)
-    for (int t = 0; t < nthr; ++t) {
-      double r = triad_rate(thr[t]);
-      triad[t] = r > triad[t] ? r : triad[t];
-    }
-  printf("  memory bandwidth (STREAM triad, best of 3 turns): %d thr %.1f GB/s",
-         thr[0], triad[0] / 1e9);
-  if (nthr > 1 && triad[0] > 0.0)
-    printf(", %d thr %.1f GB/s (%.2fx): the most a case bound by memory "
-           "gains from threads",
-           thr[1], triad[1] / 1e9, triad[1] / triad[0]);
-  printf("\n");
+    for (int k = 0; k < 2; ++k)
+      for (int t = 0; t < nthr; ++t) {
+        double r = machine_rate(thr[t], k);
+        speed[k][t] = r > speed[k][t] ? r : speed[k][t];
+      }
+  static const char *const what[2] = {"memory bandwidth (STREAM triad",
+                                      "arithmetic (multiply-add chains"};
+  static const char *const unit[2] = {"GB/s", "GFlop/s"};
+  static const char *const bound[2] = {"memory", "arithmetic"};
+  for (int k = 0; k < 2; ++k) {
+    printf("  %s, best of 3 turns): %d thr %.1f %s", what[k], thr[0],
+           speed[k][0] / 1e9, unit[k]);
+    if (nthr > 1 && speed[k][0] > 0.0)
+      printf(", %d thr %.1f %s (%.2fx): the most a case bound by %s gains "
+             "from threads",
+             thr[1], speed[k][1] / 1e9, unit[k], speed[k][1] / speed[k][0],
+             bound[k]);
+    printf("\n");
+  }
   bench_result *res = calloc((size_t)(ncases * nthr), sizeof *res);
   if (!res) {
     free(cases);
@@ -822,7 +839,7 @@ int sph_cmd_bench(int argc, char **argv) {
     }
   rc = failed ? SPH_EXIT_FAIL : SPH_EXIT_OK;
   if (json && write_json(json, cases, ncases, res, nthr, quick, cores,
-                         baseline_kb, triad) != 0) {
+                         baseline_kb, speed) != 0) {
     fprintf(stderr, "sph bench: cannot write %s\n", json);
     rc = SPH_EXIT_IO;
   }

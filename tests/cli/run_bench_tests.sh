@@ -17,8 +17,9 @@ import json, math, sys
 b = json.load(open(sys.argv[1]))
 assert b["schema_version"] == 1 and b["suite"] == "quick", b
 assert b["machine"]["cores"] >= 1 and b["machine"]["cpu"], b["machine"]
-triad = b["machine"]["triad_gb_per_s"]
-assert 1 <= len(triad) <= 2 and all(math.isfinite(v) and v > 0 for v in triad), triad
+for key in ("triad_gb_per_s", "multiply_add_gflop_per_s"):
+    v = b["machine"][key]
+    assert 1 <= len(v) <= 2 and all(math.isfinite(x) and x > 0 for x in v), (key, v)
 cases = b["cases"]
 names = {c["name"] for c in cases}
 assert len(names) == 9, names
