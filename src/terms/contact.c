@@ -78,6 +78,7 @@ static int near_other_body(const contact *ct, const double *x, int b,
 static sph_status ghosts_cover(const contact *ct, const double *x,
                                sph_error *err) {
   double d2max = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : d2max)
   for (size_t a = 0; a < ct->n; ++a) {
     double d2 = 0.0;
     for (int c = 0; c < 3; ++c) {
