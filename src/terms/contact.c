@@ -10,7 +10,16 @@
  * (dp_a + dp_b) / 2 between particles. Mirrored about a wall, a pair of
  * particles feels exactly the wall's force. The force is conservative and
  * equal and opposite across a pair, so momentum is kept to round-off; the
- * spring bounds the time step (term_stable_dt). */
+ * spring bounds the time step (term_stable_dt).
+ *
+ * Over MPI ranks (issue 20) a wall acts on each owned particle alone. Pairs
+ * of bodies need the dynamic domain of the updated-Lagrangian methods: its
+ * ghosts (the other ranks' particles within a kernel support at the last
+ * rebuild) carry their current positions, the pair lists are sorted into
+ * the serial storage order and only owned particles take a force, so each
+ * pair's force is the same bits on both ranks and the serial run's sums
+ * are repeated. The ghost layer covers the contact radius while no particle
+ * has moved more than (support - r_c) / 2 since the rebuild (checked). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,8 +28,10 @@
 #include "terms/terms_impl.h"
 
 typedef struct contact {
-  size_t n;
+  size_t n;  /* owned particles */
+  size_t ne; /* and the ghosts of a dynamic domain */
   int dim;
+  int per_volume; /* dp is a momentum rate per V0 */
   const sph_contact *spec;
   double kappa;
   double *inv_mass; /* 1 / V0 (dp is a momentum rate) or 1 / m */
@@ -38,6 +49,11 @@ typedef struct contact {
   double *xc;
   int32_t *bc;
   sph_neighbors *nl;
+  /* over MPI ranks: positions at the last ghost search, and the distance a
+   * particle may move from them while the ghosts cover the contact radius */
+  sph_domain *dom;
+  double *x_found;
+  double slack;
 } contact;
 
 /* A particle of body b within `pad` of the box of another body. */
@@ -56,24 +72,53 @@ static int near_other_body(const contact *ct, const double *x, int b,
   return 0;
 }
 
-/* the pair forces of particles near another body, into dp */
+/* over MPI ranks: every pair closer than the contact radius joins an owned
+ * particle and a ghost while no particle has moved more than `slack` since
+ * the ghosts were found (collective) */
+static sph_status ghosts_cover(const contact *ct, const double *x,
+                               sph_error *err) {
+  double d2max = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : d2max)
+  for (size_t a = 0; a < ct->n; ++a) {
+    double d2 = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      double u = x[3 * a + c] - ct->x_found[3 * a + c];
+      d2 += u * u;
+    }
+    d2max = fmax(d2max, d2);
+  }
+  d2max = sph_domain_max(ct->dom, d2max);
+  if (d2max <= ct->slack * ct->slack)
+    return SPH_OK;
+  return sph_error_set(err, SPH_ERR_RANGE,
+                       "contact over MPI ranks: a particle moved %.3g "
+                       "spacings since the ghosts were found, more than the "
+                       "%.3g the ghost layer leaves beyond the contact "
+                       "radius; update the reference more often "
+                       "(method.update_every or update_distance)",
+                       sqrt(d2max) / ct->radius, ct->slack / ct->radius);
+}
+
+/* the pair forces of particles near another body, into dp (owned ones) */
 static sph_status between_bodies(contact *ct, const sph_sim *sim,
                                  sph_stage *stage, sph_error *err) {
   const double *x = stage->x;
   const int32_t *body = sim->ps->body;
+  if (ct->dom)
+    SPH_TRY(ghosts_cover(ct, x, err));
   for (int b = 0; b < ct->nbodies; ++b)
     for (int c = 0; c < 3; ++c) {
       ct->box[6 * b + c] = INFINITY;
       ct->box[6 * b + 3 + c] = -INFINITY;
     }
-  for (size_t a = 0; a < ct->n; ++a)
+  for (size_t a = 0; a < ct->ne; ++a)
     for (int c = 0; c < 3; ++c) {
       double *bx = ct->box + 6 * body[a];
       bx[c] = fmin(bx[c], x[3 * a + c]);
       bx[3 + c] = fmax(bx[3 + c], x[3 * a + c]);
     }
   size_t nc = 0;
-  for (size_t a = 0; a < ct->n; ++a)
+  for (size_t a = 0; a < ct->ne; ++a)
     if (near_other_body(ct, x + 3 * a, body[a], ct->radius)) {
       ct->cand[nc] = a;
       memcpy(ct->xc + 3 * nc, x + 3 * a, 3 * sizeof *x);
@@ -84,14 +129,20 @@ static sph_status between_bodies(contact *ct, const sph_sim *sim,
   SPH_TRY(sph_neighbors_build(ct->nl, ct->xc, nc, ct->dim, ct->radius, ct->bc,
                               SPH_PAIRS_OTHER_BODY, err));
   const sph_neighbors *nl = ct->nl;
+  /* the lists name particles, in the serial run's order over ranks */
+  for (size_t s = 0; s < nl->count; ++s)
+    nl->index[s] = (int32_t)ct->cand[nl->index[s]];
+  sph_domain_sort_lists(ct->dom, ct->nl, nc);
   const double kappa = ct->kappa;
   double *dp = stage->dp;
 #pragma omp parallel for schedule(static)
   for (size_t i = 0; i < nc; ++i) {
     size_t a = ct->cand[i];
+    if (a >= ct->n) /* a ghost: its owner adds its force */
+      continue;
     double f[3] = {0, 0, 0};
     for (size_t s = nl->offset[i]; s < nl->offset[i + 1]; ++s) {
-      size_t j = (size_t)nl->index[s], b = ct->cand[j];
+      size_t b = (size_t)nl->index[s];
       double e[3], r2 = 0.0;
       for (int c = 0; c < 3; ++c) {
         e[c] = x[3 * a + c] - x[3 * b + c];
@@ -146,6 +197,41 @@ static double contact_stable_dt(sph_term *term, const sph_sim *sim) {
   return ((contact *)term->data)->dt_bound;
 }
 
+/* a particle's spring: the material and body values of points [0, ne) */
+static void particle_constants(contact *ct, const sph_sim *sim) {
+  const sph_scene *s = sim->scene;
+  const sph_particles *ps = sim->ps;
+  const double *V0 = ps->field[SPH_FIELD_VOLUME0];
+  for (size_t a = 0; a < ct->ne; ++a) {
+    const sph_body *b = &s->bodies[ps->body[a]];
+    const sph_material *mat = &s->materials[b->material];
+    ct->spacing[a] = b->spacing;
+    ct->modulus[a] = mat->lambda + 2.0 * mat->mu;
+    ct->area[a] = V0[a] / b->spacing;
+    ct->inv_mass[a] =
+        ct->per_volume ? 1.0 / V0[a] : 1.0 / (mat->density * V0[a]);
+  }
+}
+
+/* the owned particles and ghosts after a rebuild of the dynamic domain */
+static void take_points(contact *ct, const sph_sim *sim) {
+  ct->n = ct->ne = sim->ps->n;
+  if (!ct->dom)
+    return;
+  ct->ne += sph_domain_ghosts(ct->dom);
+  memcpy(ct->x_found, sim->ps->field[SPH_FIELD_POSITION],
+         3 * ct->ne * sizeof *ct->x_found);
+}
+
+static sph_status contact_renumber(sph_term *term, sph_sim *sim,
+                                   sph_error *err) {
+  (void)err;
+  contact *ct = term->data;
+  take_points(ct, sim);
+  particle_constants(ct, sim);
+  return SPH_OK;
+}
+
 static void contact_destroy(sph_term *term) {
   contact *ct = term->data;
   if (!ct)
@@ -158,6 +244,7 @@ static void contact_destroy(sph_term *term) {
   free(ct->cand);
   free(ct->xc);
   free(ct->bc);
+  free(ct->x_found);
   sph_neighbors_destroy(ct->nl);
   free(ct);
 }
@@ -165,72 +252,106 @@ static void contact_destroy(sph_term *term) {
 static const sph_term_ops contact_ops = {
     .name = "contact",
     .reference = "seed 001 sec. 2.4.2-2.4.3 (frictionless contact, penalty)",
+    .distributed = 1,
     .rates = contact_rates,
     .stable_dt = contact_stable_dt,
+    .renumber = contact_renumber,
     .destroy = contact_destroy,
 };
+
+/* Pairs of bodies over ranks need ghosts that follow the current positions:
+ * the fixed reference ghosts of the total-Lagrangian methods do not. */
+static sph_status refuse_fixed_ghosts(const sph_sim *sim, sph_error *err) {
+  const sph_node *root = sim->scene->root, *c = sph_node_child(root, "contact");
+  const sph_node *key = c ? sph_node_child(c, "between_bodies") : NULL;
+  return sph_node_error(
+      key ? key : root, err, SPH_ERR_UNSUPPORTED,
+      "contact between bodies does not run over MPI ranks with %s (its "
+      "ghosts are fixed in the reference configuration and do not follow "
+      "the bodies); ul-csph runs it over ranks (--set 'method={name: "
+      "ul-csph}'), or run without mpirun",
+      sim->method->name);
+}
 
 sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_particles *ps = sim->ps;
-  const size_t n = ps->n, nn = n ? n : 1;
+  if (sim->domain && s->contact.between_bodies &&
+      sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
+    return refuse_fixed_ghosts(sim, err);
+  /* room for every particle a rank may hold after migrations */
+  const size_t cap = sph_domain_capacity(sim->domain, ps), nn = cap ? cap : 1;
   contact *ct = calloc(1, sizeof *ct);
   sph_term t = {.data = ct};
   if (!ct)
     return sph_error_set(err, SPH_ERR_NOMEM, "contact");
-  ct->n = n;
   ct->dim = s->dimension;
   ct->spec = &s->contact;
   ct->kappa = s->contact.stiffness;
+  ct->per_volume = rho0 != NULL;
   ct->between = s->contact.between_bodies;
   ct->nbodies = (int)s->nbodies;
+  if (ct->between && sim->domain)
+    ct->dom = sim->domain;
   ct->inv_mass = malloc(nn * sizeof *ct->inv_mass);
   ct->modulus = malloc(nn * sizeof *ct->modulus);
   ct->area = malloc(nn * sizeof *ct->area);
   ct->spacing = malloc(nn * sizeof *ct->spacing);
-  if (!ct->inv_mass || !ct->modulus || !ct->area || !ct->spacing) {
+  ct->x_found = ct->dom ? malloc(3 * nn * sizeof *ct->x_found) : NULL;
+  sph_status st = SPH_OK;
+  if (!ct->inv_mass || !ct->modulus || !ct->area || !ct->spacing ||
+      (ct->dom && !ct->x_found))
+    st = sph_error_set(err, SPH_ERR_NOMEM, "contact");
+  st = sph_domain_agree(sim->domain, st, err);
+  if (st != SPH_OK) {
     contact_destroy(&t);
-    return sph_error_set(err, SPH_ERR_NOMEM, "contact");
+    return st;
   }
+  take_points(ct, sim);
+  particle_constants(ct, sim);
   /* the contact spring of a particle (at most about four springs' worth
-   * between bodies, two on a wall) stays below 1 / dt */
+   * between bodies, two on a wall) stays below 1 / dt, over every rank */
   double omega2 = 0.0;
-  const double *V0 = ps->field[SPH_FIELD_VOLUME0];
-  for (size_t a = 0; a < n; ++a) {
-    const sph_body *b = &s->bodies[ps->body[a]];
-    const sph_material *mat = &s->materials[b->material];
-    ct->spacing[a] = b->spacing;
-    ct->modulus[a] = mat->lambda + 2.0 * mat->mu;
-    ct->area[a] = V0[a] / b->spacing;
-    double mass = mat->density * V0[a];
-    ct->inv_mass[a] = rho0 ? 1.0 / V0[a] : 1.0 / mass;
-    double k = ct->kappa * ct->modulus[a] * ct->area[a] / (0.5 * b->spacing);
+  for (size_t a = 0; a < ct->n; ++a) {
+    double k =
+        ct->kappa * ct->modulus[a] * ct->area[a] / (0.5 * ct->spacing[a]);
+    double mass = s->materials[s->bodies[ps->body[a]].material].density *
+                  ps->field[SPH_FIELD_VOLUME0][a];
     omega2 = fmax(omega2, 2.0 * k / mass);
   }
+  omega2 = sph_domain_max(sim->domain, omega2);
   ct->dt_bound = omega2 > 0.0 ? 1.0 / sqrt(omega2) : INFINITY;
   if (ct->between) {
     for (size_t k = 0; k < s->nbodies; ++k)
       ct->radius = fmax(ct->radius, s->bodies[k].spacing);
+    /* a ghost is within a support of an owned particle at the rebuild */
+    ct->slack = 0.5 * (sim->kernel.support - ct->radius);
     ct->box = malloc(6 * s->nbodies * sizeof *ct->box);
     ct->cand = malloc(nn * sizeof *ct->cand);
     ct->xc = malloc(3 * nn * sizeof *ct->xc);
     ct->bc = malloc(nn * sizeof *ct->bc);
-    sph_status st = !ct->box || !ct->cand || !ct->xc || !ct->bc
-                        ? sph_error_set(err, SPH_ERR_NOMEM, "contact")
-                        : sph_neighbors_create(&ct->nl, err);
+    st = !ct->box || !ct->cand || !ct->xc || !ct->bc
+             ? sph_error_set(err, SPH_ERR_NOMEM, "contact")
+             : sph_neighbors_create(&ct->nl, err);
     /* room for the searches of the time steps, made here: every pair of
      * the reference set within 1.5 contact distances (a contact lists
      * only surface particles' pairs within one) */
     if (st == SPH_OK)
-      st = sph_neighbors_build(ct->nl, ps->field[SPH_FIELD_POSITION0], n,
+      st = sph_neighbors_build(ct->nl, ps->field[SPH_FIELD_POSITION0], ct->ne,
                                ct->dim, 1.5 * ct->radius, NULL, SPH_PAIRS_ALL,
                                err);
+    if (st == SPH_OK && ct->dom && !(ct->slack > 0.0))
+      st = sph_error_at(err, SPH_ERR_UNSUPPORTED, s->path, s->contact.line,
+                        s->contact.col, "contact",
+                        "contact between bodies over MPI ranks needs a "
+                        "kernel support wider than the largest spacing");
+    st = sph_domain_agree(sim->domain, st, err);
     if (st != SPH_OK) {
       contact_destroy(&t);
       return st;
     }
   }
-  sph_status st = sph_sim_add_term(sim, &contact_ops, ct, err);
+  st = sph_sim_add_term(sim, &contact_ops, ct, err);
   if (st != SPH_OK)
     contact_destroy(&t);
   return st;

@@ -37,8 +37,6 @@ no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
 check "no stale pieces" no_stale
 
 # refusals: exit 2 on every rank, the folder never made
-expect="the term contact does not run over MPI ranks yet"
-check "contact term refused" refused run rubber_rings_ul_csph --quiet
 expect="symmetry planes"
 check "symmetry planes refused" refused run swinging_cube --quiet \
   --set 'method={name: tl-csph}'

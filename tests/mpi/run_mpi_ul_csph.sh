@@ -9,8 +9,8 @@
 # come from their owners, so every pair sum runs in the serial order. The
 # punch's symmetry planes are mirror images, refused over ranks, so the 2D
 # path runs the punch with rollers on those planes; the same rank count twice
-# writes the same bytes; the punch as shipped and the contact term of the
-# rings are refused.
+# writes the same bytes; the punch as shipped is refused (the contact term of
+# the rings: run_mpi_contact.sh).
 # Usage: run_mpi_ul_csph.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -42,6 +42,4 @@ check "bar np 4 twice: identical files" same_bytes "$work/bar.np4" \
 # refusals: exit 2 on every rank, the folder never made
 expect="symmetry planes (mirror images) do not run over MPI ranks yet"
 check "punch with symmetry planes refused" refused run punch_ul_csph --quiet
-expect="the term contact does not run over MPI ranks yet"
-check "contact term refused" refused run rubber_rings_ul_csph --quiet
 summary
