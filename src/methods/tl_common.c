@@ -315,7 +315,8 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
   r->n_img = ni;
   r->n_ext = total;
   r->sync_images = dom && np;
-  sph_domain_set_ghost_base(dom, ni);
+  if (!sph_domain_migrates(dom)) /* a dynamic domain's ghosts follow ps */
+    sph_domain_set_ghost_base(dom, ni);
   r->mirror = (sph_mirror){.n_real = n,
                            .n_ghost = ni - n,
                            .src = r->src + n,

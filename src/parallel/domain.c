@@ -241,6 +241,17 @@ static sph_status find_ghosts(const sph_particles *ps, const int *owner, int r,
   return st;
 }
 
+/* corner k (bit c: hi along c) of the box lo, hi into X; its signed
+ * distance from the plane */
+static double box_corner(const sph_domain_plane *p, const double *lo,
+                         const double *hi, int k, double X[3]) {
+  for (int c = 0; c < 3; ++c)
+    X[c] = k >> c & 1 ? hi[c] : lo[c];
+  return p->axis >= 0
+             ? X[p->axis] - p->at
+             : X[0] * p->n[0] + X[1] * p->n[1] + X[2] * p->n[2] - p->at;
+}
+
 /* reflection of the box lo, hi (bounding the reflected corners) */
 static void reflect_box(const sph_domain_plane *p, const double *lo,
                         const double *hi, double *out) {
@@ -248,12 +259,7 @@ static void reflect_box(const sph_domain_plane *p, const double *lo,
   for (int c = 0; c < 3; ++c)
     olo[c] = INFINITY, ohi[c] = -INFINITY;
   for (int k = 0; k < 8; ++k) {
-    double X[3];
-    for (int c = 0; c < 3; ++c)
-      X[c] = k >> c & 1 ? hi[c] : lo[c];
-    double dist =
-        p->axis >= 0 ? X[p->axis] - p->at
-                     : X[0] * p->n[0] + X[1] * p->n[1] + X[2] * p->n[2] - p->at;
+    double X[3], dist = box_corner(p, lo, hi, k, X);
     for (int c = 0; c < 3; ++c) {
       double y = p->axis >= 0 ? (c == p->axis ? 2.0 * p->at - X[c] : X[c])
                               : X[c] - 2.0 * dist * p->n[c];
@@ -268,12 +274,7 @@ static int box_near(const sph_domain_plane *p, const double *lo,
                     const double *hi, double layer) {
   double dmin = INFINITY, dmax = -INFINITY;
   for (int k = 0; k < 8; ++k) {
-    double X[3];
-    for (int c = 0; c < 3; ++c)
-      X[c] = k >> c & 1 ? hi[c] : lo[c];
-    double dist =
-        p->axis >= 0 ? X[p->axis] - p->at
-                     : X[0] * p->n[0] + X[1] * p->n[1] + X[2] * p->n[2] - p->at;
+    double X[3], dist = box_corner(p, lo, hi, k, X);
     dmin = fmin(dmin, dist);
     dmax = fmax(dmax, dist);
   }
