@@ -38,6 +38,30 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
                              double support, sph_error *err);
 void sph_domain_destroy(sph_domain *d);
 
+/* A symmetry or skew-symmetry plane X . n = at (axis: the coordinate axis of
+ * n, or -1) whose mirror images the method builds over owned and ghost
+ * particles (methods/tl_common.c). */
+typedef struct sph_domain_plane {
+  double n[3], at;
+  int axis;
+} sph_domain_plane;
+/* sph_domain_create for a run with mirror images: the ghosts are also the
+ * particles within two supports of the owned ones or of their reflections
+ * (chained over the planes, each within four supports of its plane), so a
+ * rank holds the sources of every image within one support of an owned
+ * particle and the whole neighbourhood of each such image. */
+sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
+                                      double support,
+                                      const sph_domain_plane *planes,
+                                      int nplanes, sph_error *err);
+/* Storage indices in the whole set of the owned particles, then of the
+ * ghosts (NULL for NULL). */
+const int64_t *sph_domain_storage_index(const sph_domain *d);
+/* Exchanges write the ghosts' values from point `base` on (default: right
+ * after the owned particles), for a method that keeps other points (mirror
+ * images) in between. */
+void sph_domain_set_ghost_base(sph_domain *d, size_t base);
+
 int sph_domain_rank(const sph_domain *d);
 int sph_domain_size(const sph_domain *d);
 
@@ -60,6 +84,8 @@ sph_halo sph_domain_halo(sph_domain *d);
  * followed by the ghosts, by the particles' storage index in the whole set:
  * pair sums then run in the order of the serial run. */
 void sph_domain_sort_lists(const sph_domain *d, sph_neighbors *nl, size_t n);
+/* The same by key[point] (ascending) for every point of the lists. */
+void sph_domain_sort_lists_by(sph_neighbors *nl, size_t n, const int64_t *key);
 
 /* Sets the ghosts' ncomp values, field + ncomp * n_owned onwards, from
  * their owners' (non-blocking point to point). */

@@ -100,17 +100,48 @@ static inline double plane_distance(const plane *pl, const double *X) {
   return X[0] * pl->n[0] + X[1] * pl->n[1] + X[2] * pl->n[2] - pl->at;
 }
 
+/* a local real point and its storage index in the whole set */
+typedef struct stored {
+  int64_t key;
+  size_t i;
+} stored;
+
+static int cmp_stored(const void *pa, const void *pb) {
+  const stored *a = pa, *b = pb;
+  return (a->key > b->key) - (a->key < b->key);
+}
+
+/* moves the ng points from n on behind the m that follow them, w bytes a
+ * point (the ghosts of a distributed run after the images) */
+static sph_status rotate_points(void *base, size_t w, size_t n, size_t ng,
+                                size_t m, sph_error *err) {
+  char *a = base, *tmp = malloc(ng * w + 1);
+  if (!tmp)
+    return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+  memcpy(tmp, a + n * w, ng * w);
+  memmove(a + n * w, a + (n + ng) * w, m * w);
+  memcpy(a + (n + m) * w, tmp, ng * w);
+  free(tmp);
+  return SPH_OK;
+}
+
 /* Real points first, then images of every point within two supports of a
  * plane on its domain side; two passes over the planes complete edges,
  * corners and periodic images, duplicates are skipped. Images across
  * coordinate planes flip signs; with an oblique plane every point carries
- * its reflection as a matrix (chosen once here). */
+ * its reflection as a matrix (chosen once here). Over MPI ranks the real
+ * points are the owned particles and the ghosts, visited in the serial
+ * storage order, so the images of both come in the serial images' order
+ * (key); the ghosts then move behind the images. */
 static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
                                sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_particles *ps = sim->ps;
   const double *X0 = ps->field[SPH_FIELD_POSITION0];
+  sph_domain *dom = sim->domain;
   size_t n = ps->n, cap = 0;
+  /* other ranks' particles within a support of ours (and of our images) */
+  size_t ng = sph_domain_ghosts(dom), nr = n + ng;
   plane planes[32];
   int np = 0, oblique = 0;
   for (size_t k = 0; images && k < s->nboundaries && np < 32; ++k) {
@@ -125,20 +156,25 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     pl->sigma = bc->kind == SPH_BC_SYMMETRY ? 1 : -1;
     pl->done = 0;
     oblique |= pl->axis < 0;
-    double mean = 0.0;
-    size_t cnt = 0;
+    double mean[2] = {0.0, 0.0}; /* over the whole body: every rank's */
     for (size_t a = 0; a < n; ++a)
       if (pl->body < 0 || ps->body[a] == pl->body) {
-        mean += plane_distance(pl, X0 + 3 * a);
-        ++cnt;
+        mean[0] += plane_distance(pl, X0 + 3 * a);
+        mean[1] += 1.0;
       }
-    pl->side = cnt && mean / (double)cnt < 0.0 ? -1 : 1;
+    sph_domain_sum(dom, mean, 2);
+    pl->side = mean[1] > 0.0 && mean[0] / mean[1] < 0.0 ? -1 : 1;
   }
-  SPH_TRY(grow_points(r, n + 1, &cap, oblique, err));
+  SPH_TRY(grow_points(r, nr + 1, &cap, oblique, err));
   memcpy(r->X, X0, 3 * n * sizeof(double));
   memcpy(r->V, ps->field[SPH_FIELD_VOLUME0], n * sizeof(double));
   memcpy(r->body, ps->body, n * sizeof(int32_t));
-  for (size_t a = 0; a < n; ++a) {
+  if (ng) {
+    memcpy(r->X + 3 * n, sph_domain_ghost_X(dom), 3 * ng * sizeof(double));
+    memcpy(r->V + n, sph_domain_ghost_volume(dom), ng * sizeof(double));
+    memcpy(r->body + n, sph_domain_ghost_body(dom), ng * sizeof(int32_t));
+  }
+  for (size_t a = 0; a < nr; ++a) {
     r->src[a] = (int32_t)a;
     memset(r->vsign + 3 * a, 1, 3);
     memset(r->rsign + 3 * a, 1, 3);
@@ -146,21 +182,32 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     if (oblique)
       sph_mat3_identity(r->vmat + 9 * a);
   }
-  size_t total = n;
+  /* over ranks the real points in the serial storage order */
+  stored *order = NULL;
+  if (np && dom) {
+    const int64_t *gidx = sph_domain_storage_index(dom);
+    if (!(order = malloc(nr * sizeof *order)))
+      return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+    for (size_t a = 0; a < nr; ++a)
+      order[a] = (stored){gidx[a], a};
+    qsort(order, nr, sizeof *order, cmp_stored);
+  }
+  size_t total = nr;
   if (np) {
     double layer = 2.0 * sim->kernel.support, q = 1e-6 * sim->dp;
     hash h = {0};
-    h.cap = 16 * n > 65536 ? 16 * n : 65536;
+    h.cap = 16 * nr > 65536 ? 16 * nr : 65536;
     h.key = malloc(3 * h.cap * sizeof *h.key);
     h.used = calloc(h.cap, 1);
     if (!h.key || !h.used) {
       free(h.key);
       free(h.used);
+      free(order);
       return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
     }
     sph_status st = SPH_OK;
     int full = 0;
-    for (size_t a = 0; a < n; ++a) {
+    for (size_t a = 0; a < nr; ++a) {
       int64_t key[3];
       for (int c = 0; c < 3; ++c)
         key[c] = llround(r->X[3 * a + c] / q);
@@ -170,7 +217,8 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
       for (int k = 0; k < np && st == SPH_OK; ++k) {
         plane *pl = &planes[k];
         size_t count = total;
-        for (size_t i = pl->done; i < count && st == SPH_OK; ++i) {
+        for (size_t v = pl->done; v < count && st == SPH_OK; ++v) {
+          size_t i = order && v < nr ? order[v].i : v;
           if (pl->body >= 0 && r->body[i] != pl->body)
             continue;
           double dist = plane_distance(pl, r->X + 3 * i), d = dist * pl->side;
@@ -221,28 +269,56 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     free(h.used);
     if (st == SPH_OK && full)
       st = sph_error_set(err, SPH_ERR_NOMEM, "mirror image table is full");
-    if (st != SPH_OK)
+    if (st != SPH_OK) {
+      free(order);
       return st;
+    }
   }
-  /* other ranks' particles within a support of ours */
-  size_t ng = sph_domain_ghosts(sim->domain);
+  size_t ni = total - ng; /* owned and images */
   /* an updated-Lagrangian run over ranks holds up to the domain's capacity */
-  size_t hold = sph_domain_capacity(sim->domain, ps);
-  r->cap = total + ng > hold ? total + ng : hold;
+  size_t hold = sph_domain_capacity(dom, ps);
+  r->cap = total > hold ? total : hold;
   SPH_TRY(grow_points(r, r->cap, &cap, oblique, err));
-  for (size_t g = 0; g < ng; ++g) {
-    size_t i = total + g;
-    memcpy(r->X + 3 * i, sph_domain_ghost_X(sim->domain) + 3 * g,
-           3 * sizeof *r->X);
-    r->V[i] = sph_domain_ghost_volume(sim->domain)[g];
-    r->body[i] = sph_domain_ghost_body(sim->domain)[g];
-    r->src[i] = -1;
+  if (dom && !sph_domain_migrates(dom)) { /* the serial order of points */
+    const int64_t *gidx = sph_domain_storage_index(dom);
+    sph_status st = (r->key = malloc(r->cap * sizeof *r->key))
+                        ? SPH_OK
+                        : sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+    for (size_t a = 0; st == SPH_OK && a < total; ++a)
+      r->key[a < n    ? a
+             : a < nr ? a + ni - n
+                      : a - ng] =
+          a < nr ? gidx[a] : ((int64_t)1 << 40) + (int64_t)a;
+    if (st != SPH_OK) {
+      free(order);
+      return st;
+    }
+  }
+  free(order);
+  /* the ghosts behind the images; sources renumbered to match */
+  size_t m = total - nr;
+  for (size_t a = n; ng && a < total; ++a)
+    if ((size_t)r->src[a] >= n)
+      r->src[a] += (int32_t)((size_t)r->src[a] < nr ? m : 0);
+  if (ng && m) {
+    SPH_TRY(rotate_points(r->X, 3 * sizeof *r->X, n, ng, m, err));
+    SPH_TRY(rotate_points(r->V, sizeof *r->V, n, ng, m, err));
+    SPH_TRY(rotate_points(r->body, sizeof *r->body, n, ng, m, err));
+    SPH_TRY(rotate_points(r->src, sizeof *r->src, n, ng, m, err));
+    SPH_TRY(rotate_points(r->vsign, 3, n, ng, m, err));
+    SPH_TRY(rotate_points(r->rsign, 3, n, ng, m, err));
+    SPH_TRY(rotate_points(r->ssign, 1, n, ng, m, err));
+    if (oblique)
+      SPH_TRY(rotate_points(r->vmat, 9 * sizeof *r->vmat, n, ng, m, err));
   }
   r->n = n;
-  r->n_img = total;
-  r->n_ext = total + ng;
+  r->n_img = ni;
+  r->n_ext = total;
+  r->sync_images = dom && np;
+  if (!sph_domain_migrates(dom)) /* a dynamic domain's ghosts follow ps */
+    sph_domain_set_ghost_base(dom, ni);
   r->mirror = (sph_mirror){.n_real = n,
-                           .n_ghost = total - n,
+                           .n_ghost = ni - n,
                            .src = r->src + n,
                            .vsign = r->vsign + 3 * n,
                            .vmat = oblique ? r->vmat + 9 * n : NULL,
@@ -398,7 +474,10 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
                               sim->kernel.support, ref->body,
                               SPH_PAIRS_SAME_BODY, err));
   /* a distributed run sums pairs in the serial run's order */
-  sph_domain_sort_lists(sim->domain, ref->nl, ref->n_img);
+  if (ref->key)
+    sph_domain_sort_lists_by(ref->nl, ref->n_img, ref->key);
+  else
+    sph_domain_sort_lists(sim->domain, ref->nl, ref->n_img);
   if (ref->nl->count + 1 > ref->w_cap) { /* grows only, amortised */
     size_t cap = 2 * (ref->nl->count + 1);
     double *w = realloc(ref->w, cap * sizeof *w);
@@ -526,9 +605,11 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   int64_t *id = malloc(ref->cap * sizeof *id);
   if (!id)
     return sph_error_set(err, SPH_ERR_NOMEM, "ids");
-  for (size_t a = 0; a < ne; ++a)
-    id[a] = a < ref->n_img ? ps->id[ref->src[a]]
-                           : sph_domain_ghost_id(sim->domain)[a - ref->n_img];
+  for (size_t a = 0; a < ne; ++a) { /* an image's is its source's */
+    size_t r = (size_t)ref->src[a];
+    id[a] =
+        r < n ? ps->id[r] : sph_domain_ghost_id(sim->domain)[r - ref->n_img];
+  }
   ref->id = id;
   ref->s = calloc(3 * ref->cap + 3, sizeof *ref->s);
   if (!ref->s)
@@ -559,6 +640,7 @@ void tl_reference_destroy(tl_reference *ref) {
   free(ref->rsign);
   free(ref->ssign);
   free(ref->vmat);
+  free(ref->key);
   free(ref->axes);
   if (ref->owns_state) {
     free(ref->x);
@@ -645,6 +727,13 @@ void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
     if (J)
       J[g] = 1.0 + sigma * (J[s] - 1.0);
   }
+}
+
+sph_status tl_image_sources(const sph_sim *sim, const tl_reference *ref,
+                            double *field, int ncomp, sph_error *err) {
+  if (!ref->sync_images)
+    return SPH_OK;
+  return sph_domain_exchange(sim->domain, field, ncomp, err);
 }
 
 void tl_derive(sph_sim *sim, const tl_reference *ref, const double *H,

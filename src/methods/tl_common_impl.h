@@ -57,6 +57,13 @@ typedef struct tl_reference {
   int32_t *src;
   signed char *vsign, *rsign, *ssign;
   double *vmat; /* 9 per point with an oblique plane (sph_mirror), or NULL */
+  /* over MPI ranks: the serial run's order of the points (storage index of
+   * a real, then the images' order), which the lists are sorted by; NULL
+   * without a fixed domain */
+  int64_t *key;
+  /* over MPI ranks with mirror images, whose sources may be ghosts: the
+   * ghosts' state is exchanged before the images are refreshed */
+  int sync_images;
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as
@@ -162,6 +169,11 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
  * the composed reflection (sign flips across coordinate planes). */
 void tl_mirror_refresh(const tl_reference *ref, double *x, double *p, double *F,
                        double *H, double *J);
+/* Over MPI ranks with mirror images (sync_images): the ghosts' values of
+ * `field` (ncomp a point), which the images of ghosts mirror, from their
+ * owners; else nothing. */
+sph_status tl_image_sources(const sph_sim *sim, const tl_reference *ref,
+                            double *field, int ncomp, sph_error *err);
 
 /* Derived fields of the real particles: velocity, displacement, J, Cauchy
  * stress, pressure tr(sigma)/3 (seed 000 eq. 11), von Mises; copies the

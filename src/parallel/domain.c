@@ -77,6 +77,13 @@ const double *sph_domain_ghost_volume(const sph_domain *d) { return d->gV; }
 const int32_t *sph_domain_ghost_body(const sph_domain *d) { return d->gbody; }
 const int64_t *sph_domain_ghost_id(const sph_domain *d) { return d->gid; }
 int sph_domain_migrates(const sph_domain *d) { return d && d->dyn; }
+const int64_t *sph_domain_storage_index(const sph_domain *d) {
+  return d ? d->gidx : NULL;
+}
+void sph_domain_set_ghost_base(sph_domain *d, size_t base) {
+  if (d)
+    d->base = base;
+}
 sph_particles *sph_domain_global(const sph_domain *d) {
   return d ? d->all : NULL;
 }
@@ -234,6 +241,114 @@ static sph_status find_ghosts(const sph_particles *ps, const int *owner, int r,
   return st;
 }
 
+/* corner k (bit c: hi along c) of the box lo, hi into X; its signed
+ * distance from the plane */
+static double box_corner(const sph_domain_plane *p, const double *lo,
+                         const double *hi, int k, double X[3]) {
+  for (int c = 0; c < 3; ++c)
+    X[c] = k >> c & 1 ? hi[c] : lo[c];
+  return p->axis >= 0
+             ? X[p->axis] - p->at
+             : X[0] * p->n[0] + X[1] * p->n[1] + X[2] * p->n[2] - p->at;
+}
+
+/* reflection of the box lo, hi (bounding the reflected corners) */
+static void reflect_box(const sph_domain_plane *p, const double *lo,
+                        const double *hi, double *out) {
+  double *olo = out, *ohi = out + 3;
+  for (int c = 0; c < 3; ++c)
+    olo[c] = INFINITY, ohi[c] = -INFINITY;
+  for (int k = 0; k < 8; ++k) {
+    double X[3], dist = box_corner(p, lo, hi, k, X);
+    for (int c = 0; c < 3; ++c) {
+      double y = p->axis >= 0 ? (c == p->axis ? 2.0 * p->at - X[c] : X[c])
+                              : X[c] - 2.0 * dist * p->n[c];
+      olo[c] = fmin(olo[c], y);
+      ohi[c] = fmax(ohi[c], y);
+    }
+  }
+}
+
+/* whether some point of the box lies within `layer` of the plane */
+static int box_near(const sph_domain_plane *p, const double *lo,
+                    const double *hi, double layer) {
+  double dmin = INFINITY, dmax = -INFINITY;
+  for (int k = 0; k < 8; ++k) {
+    double X[3], dist = box_corner(p, lo, hi, k, X);
+    dmin = fmin(dmin, dist);
+    dmax = fmax(dmax, dist);
+  }
+  return dmin < layer && dmax > -layer;
+}
+
+#define MIRROR_BOXES 4096
+
+/* the ghosts mirror images need (sph_domain_create_mirrored): the box of
+ * the owned particles and its reflections across every plane it comes
+ * within four supports of, chained until no new box appears; ghost[i] = 1
+ * for every other rank's particle within two supports of one of the boxes
+ * (all of them when the boxes do not settle) */
+static sph_status find_mirror_ghosts(const sph_particles *ps, const int *owner,
+                                     int r, double support,
+                                     const sph_domain_plane *planes, int np,
+                                     char *ghost, sph_error *err) {
+  size_t N = ps->n, nb = 1;
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  double *box = malloc(6 * MIRROR_BOXES * sizeof *box);
+  if (!box)
+    return sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  for (int c = 0; c < 3; ++c)
+    box[c] = INFINITY, box[3 + c] = -INFINITY;
+  for (size_t i = 0; i < N; ++i)
+    for (int c = 0; owner[i] == r && c < ps->dim; ++c) {
+      box[c] = fmin(box[c], X[3 * i + c]);
+      box[3 + c] = fmax(box[3 + c], X[3 * i + c]);
+    }
+  for (int c = ps->dim; c < 3; ++c)
+    box[c] = box[3 + c] = 0.0;
+  double tol = 1e-9 * support;
+  int grew = 1, full = 0;
+  for (int pass = 0; grew && !full && pass < 16; ++pass) {
+    grew = 0;
+    for (int k = 0; k < np && !full; ++k)
+      for (size_t b = 0, count = nb; b < count && !full; ++b) {
+        double img[6];
+        if (!box_near(&planes[k], box + 6 * b, box + 6 * b + 3, 4.0 * support))
+          continue;
+        reflect_box(&planes[k], box + 6 * b, box + 6 * b + 3, img);
+        int seen = 0;
+        for (size_t e = 0; e < nb && !seen; ++e) {
+          seen = 1;
+          for (int c = 0; c < 6; ++c)
+            seen &= fabs(box[6 * e + c] - img[c]) <= tol;
+        }
+        if (seen)
+          continue;
+        if (nb == MIRROR_BOXES) {
+          full = 1;
+          break;
+        }
+        memcpy(box + 6 * nb++, img, sizeof img);
+        grew = 1;
+      }
+  }
+  double w = 2.0 * support;
+  for (size_t i = 0; i < N; ++i) {
+    if (owner[i] == r || ghost[i])
+      continue;
+    int in = full;
+    for (size_t b = 0; b < nb && !in; ++b) {
+      in = 1;
+      for (int c = 0; c < ps->dim; ++c)
+        in &= X[3 * i + c] >= box[6 * b + c] - w &&
+              X[3 * i + c] <= box[6 * b + 3 + c] + w;
+    }
+    ghost[i] = (char)in;
+  }
+  free(box);
+  return SPH_OK;
+}
+
 /* this rank's owned particles as a set of their own, in storage order */
 static sph_status owned_set(const sph_particles *ps, const sph_domain *d,
                             size_t capacity, sph_particles **out,
@@ -340,7 +455,9 @@ void sph_domain_gather_map(sph_domain *d) {
 /* the partition; a dynamic domain (updated Lagrangian) finds no ghosts
  * here (sph_domain_rebuild does) and holds its particles with room */
 static sph_status domain_create(sph_domain **out, sph_particles **ps,
-                                double support, int dynamic, sph_error *err) {
+                                double support, int dynamic,
+                                const sph_domain_plane *planes, int np,
+                                sph_error *err) {
   *out = NULL;
   sph_particles *all = *ps;
   size_t N = all->n;
@@ -374,6 +491,15 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
   for (size_t i = 0; st == SPH_OK && i < N; ++i) {
     d->n += owner[i] == world_rank;
     d->ng += ghost[i] != 0;
+  }
+  /* the usefulness check below counts the ghosts within one support */
+  size_t ng_support = d ? d->ng : 0;
+  if (st == SPH_OK && np > 0 && !dynamic) {
+    st = find_mirror_ghosts(all, owner, world_rank, support, planes, np, ghost,
+                            err);
+    d->ng = 0;
+    for (size_t i = 0; st == SPH_OK && i < N; ++i)
+      d->ng += ghost[i] != 0;
   }
   if (st == SPH_OK) {
     size_t m = d->n + d->ng ? d->n + d->ng : 1;
@@ -414,7 +540,7 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
   }
   /* a halo larger than the domain: more ranks than useful */
   long worst = -1;
-  if (st == SPH_OK && (d->ng > d->n || d->n == 0))
+  if (st == SPH_OK && (ng_support > d->n || d->n == 0))
     worst = world_rank;
   st = sph_domain_agree(d, st, err);
   long any = -1;
@@ -462,12 +588,19 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
 
 sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
                              double support, sph_error *err) {
-  return domain_create(out, ps, support, 0, err);
+  return domain_create(out, ps, support, 0, NULL, 0, err);
+}
+
+sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
+                                      double support,
+                                      const sph_domain_plane *planes,
+                                      int nplanes, sph_error *err) {
+  return domain_create(out, ps, support, 0, planes, nplanes, err);
 }
 
 sph_status sph_domain_create_dynamic(sph_domain **out, sph_particles **ps,
                                      double support, sph_error *err) {
-  return domain_create(out, ps, support, 1, err);
+  return domain_create(out, ps, support, 1, NULL, 0, err);
 }
 
 sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
@@ -477,10 +610,10 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
   double t0 = MPI_Wtime();
   MPI_Request *req = d->req;
   int nr = 0;
-  size_t nc = (size_t)ncomp;
+  size_t nc = (size_t)ncomp, base = d->base ? d->base : d->n;
   for (int q = 0; q < d->size; ++q)
     if (d->recv_count[q])
-      MPI_Irecv(field + nc * (d->n + (size_t)d->recv_off[q]),
+      MPI_Irecv(field + nc * (base + (size_t)d->recv_off[q]),
                 ncomp * d->recv_count[q], MPI_DOUBLE, q, 7, MPI_COMM_WORLD,
                 &req[nr++]);
   long ns = (long)d->nsend;
@@ -623,6 +756,14 @@ sph_status sph_domain_create_dynamic(sph_domain **out, sph_particles **ps,
   return sph_domain_create(out, ps, support, err);
 }
 
+sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
+                                      double support,
+                                      const sph_domain_plane *planes,
+                                      int nplanes, sph_error *err) {
+  (void)planes, (void)nplanes;
+  return sph_domain_create(out, ps, support, err);
+}
+
 sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
                                sph_error *err) {
   (void)d, (void)field, (void)ncomp, (void)err;
@@ -654,9 +795,11 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
 /* ascending storage index within each list: insertion sort of the usual
  * few tens of entries */
 void sph_domain_sort_lists(const sph_domain *d, sph_neighbors *nl, size_t n) {
-  if (!d)
-    return;
-  const int64_t *key = d->gidx;
+  if (d)
+    sph_domain_sort_lists_by(nl, n, d->gidx);
+}
+
+void sph_domain_sort_lists_by(sph_neighbors *nl, size_t n, const int64_t *key) {
   long m = (long)n;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < m; ++a) {

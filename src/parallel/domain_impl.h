@@ -13,6 +13,7 @@ struct sph_domain {
   int rank, size, dim;
   size_t n;           /* owned */
   size_t ng;          /* ghosts */
+  size_t base;        /* first ghost point of exchanged arrays (0: n) */
   int64_t *gidx;      /* storage index in the whole set: owned, then ghosts */
   double *gX, *gV;    /* ghosts' reference positions and volumes */
   int32_t *gbody;     /* ghosts' bodies */

@@ -248,14 +248,12 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
     }
     return SPH_OK;
   }
-  if (sim->domain)
-    return sph_node_error(sim->scene->reference, err, SPH_ERR_UNSUPPORTED,
-                          "an analytic reference (initial state) does not run "
-                          "over MPI ranks yet; run without mpirun");
+  /* over MPI ranks each rank sets its owned particles' state */
   SPH_TRY(sph_particles_require(ps, SPH_FIELD_DEFGRAD, err));
   SPH_TRY(sph_particles_require(ps, SPH_FIELD_POSITION, err));
   rw->P_amp = 0.0;
-  for (size_t a = 0; a < ps->n; ++a) {
+  sph_status st = SPH_OK;
+  for (size_t a = 0; st == SPH_OK && a < ps->n; ++a) {
     double u[3], v[3], G[9], P[9];
     const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
     exact(r, X, 0.0, u, v, G);
@@ -279,13 +277,16 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
     if (!(J > 0.0) || !isfinite(J) || !isfinite(rw->P_amp) ||
         !isfinite(v[0] + v[1] + v[2]) || !isfinite(u[0] + u[1] + u[2])) {
       const sph_node *ref = sim->scene->reference;
-      return sph_node_error(
+      st = sph_node_error(
           ref ? ref : sim->scene->root, err, SPH_ERR_RANGE,
           "the analytic initial state is %s at particle %zu (J = %g): "
           "a smaller amplitude",
           isfinite(J) && isfinite(rw->P_amp) ? "inverted" : "not finite", a, J);
     }
   }
+  /* every rank learns of a failure; the amplitude is a maximum, exact */
+  SPH_TRY(sph_domain_agree(sim->domain, st, err));
+  rw->P_amp = sph_domain_max(sim->domain, rw->P_amp);
   sim->initial_defgrad = 1;
   return SPH_OK;
 }

@@ -136,13 +136,25 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                           "%s); run it without mpirun",
                           sim->method->name, runs);
   }
-  for (size_t k = 0; k < s->nboundaries; ++k)
-    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
-        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY)
+  /* the planes' mirror images need the ghosts of their sources */
+  sph_domain_plane planes[32];
+  int np = 0;
+  for (size_t k = 0; k < s->nboundaries; ++k) {
+    const sph_boundary *bc = &s->boundaries[k];
+    if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
+      continue;
+    if (sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC)
       return sph_node_error(bcs && k < bcs->count ? bcs->items[k] : s->root,
                             err, SPH_ERR_UNSUPPORTED,
                             "symmetry planes (mirror images) do not run over "
-                            "MPI ranks yet; run without mpirun");
+                            "MPI ranks yet with %s; run without mpirun",
+                            sim->method->name);
+    if (np < 32) {
+      planes[np] =
+          (sph_domain_plane){.at = bc->select.at, .axis = bc->select.axis};
+      memcpy(planes[np++].n, bc->select.normal, sizeof planes->n);
+    }
+  }
   if (s->output.checkpoint_every > 0.0 &&
       sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
     const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;
@@ -153,6 +165,9 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                           "mpirun",
                           sim->method->name);
   }
+  if (np)
+    return sph_domain_create_mirrored(&sim->domain, &sim->ps,
+                                      sim->kernel.support, planes, np, err);
   if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
     return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
   return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,

@@ -5,8 +5,8 @@
 # particle ids in its fields, on 2 ranks: rank 0 observes the tip in the
 # gathered set, so summary.json gives the serial period, error and verdict,
 # and the files are the serial ones (check_mpi.py: fields and probes
-# identical, energies to 1e-12). An analytic reference (it sets the initial
-# state) is refused.
+# identical, energies to 1e-12). The analytic references (they set the
+# initial state) run over ranks too: run_mpi_symmetry.sh (the swinging cube).
 # Usage: run_mpi_reference.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -25,9 +25,4 @@ same_verdict() {
 }
 check "plate np 2: the serial period and verdict" same_verdict
 verdict "$work/plate.np2"
-
-# refusals: exit 2 on every rank, the folder never made
-expect="an analytic reference (initial state) does not run over MPI ranks yet"
-check "analytic reference refused" refused run twisting_column --quiet \
-  --set 'reference={analytic: swinging_cube}'
 summary

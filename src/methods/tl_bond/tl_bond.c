@@ -31,8 +31,8 @@
 /* ---- deformation and stress
  * ---------------------------------------------------- */
 
-/* F^c of the real particles (eq. 37-39), mirrored onto the images */
-static void bond_defgrad(tl_bond *m, long n) {
+/* F^c of the real particles (eq. 37-39) */
+static void bond_defgrad_owned(tl_bond *m, long n) {
   const tl_reference *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
 #pragma omp parallel for schedule(static)
@@ -45,8 +45,17 @@ static void bond_defgrad(tl_bond *m, long n) {
                            m->q + 3 * k);
     memcpy(m->Fc + 9 * a, Fc, sizeof Fc);
   }
+}
+
+/* the same mirrored onto the images (over MPI ranks those of ghosts from
+ * the ghosts' F^c) */
+static sph_status bond_defgrad(tl_bond *m, long n, sph_error *err) {
+  const tl_reference *ref = &m->ref;
+  bond_defgrad_owned(m, n);
+  SPH_TRY(tl_image_sources(m->sim, ref, m->Fc, 9, err));
   if (ref->n_ext > ref->n)
     tl_mirror_refresh(ref, m->x, m->p, m->Fc, NULL, NULL);
+  return SPH_OK;
 }
 
 /* images from their sources, F^c (or F) into *Fs, P at it for every
@@ -57,13 +66,15 @@ static sph_status deformation_and_stress(tl_bond *m, const double **Fs,
   tl_reference *ref = &m->ref;
   sph_domain *d = m->sim->domain;
   long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
-  if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
   SPH_TRY(sph_domain_exchange(d, m->x, 3, err));
   SPH_TRY(sph_domain_exchange(d, m->p, 3, err));
+  if (!m->bond) /* the images' stress is at their F */
+    SPH_TRY(tl_image_sources(m->sim, ref, m->F, 9, err));
+  if (ne > n)
+    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
   *Fs = m->F;
   if (m->bond) {
-    bond_defgrad(m, n);
+    SPH_TRY(bond_defgrad(m, n, err));
     *Fs = m->Fc;
   }
 #pragma omp parallel for schedule(static)
@@ -129,11 +140,13 @@ static double tl_bond_stable_dt(sph_sim *sim) {
   const tl_reference *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
+  /* over MPI ranks the pairs read the ghosts' x and stretches, the images
+   * of ghosts the ghosts' x and F */
+  if (sph_domain_exchange(sim->domain, m->x, 3, NULL) != SPH_OK ||
+      (m->pair_speed && tl_image_sources(sim, ref, m->F, 9, NULL) != SPH_OK))
+    return NAN;
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  /* over MPI ranks the pairs read the ghosts' x and stretches */
-  if (sph_domain_exchange(sim->domain, m->x, 3, NULL) != SPH_OK)
-    return NAN;
   double lam_min = 1.0;
   if (m->pair_speed) {
     lam_min = INFINITY;
@@ -187,7 +200,7 @@ static void tl_bond_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_bond *m = sim->method_data;
   tl_reference r = m->ref;
   if (m->bond) {
-    bond_defgrad(m, (long)r.n);
+    bond_defgrad_owned(m, (long)r.n);
     r.F = m->Fc;
   }
   tl_energy(sim, &r, NULL, NULL, kinetic, strain);

@@ -20,9 +20,9 @@ static sph_status deformation_and_stress(tl_csph *m, long n, sph_error *err) {
   tl_reference *ref = &m->ref;
   long ne = (long)ref->n_ext;
   int dim = m->sim->scene->dimension;
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->x, 3, err));
   if (ne > n) /* image positions and momenta from their sources */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  SPH_TRY(sph_domain_exchange(m->sim->domain, m->x, 3, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* F = grad_0 x (seed 001 eq. 9) */
@@ -33,9 +33,9 @@ static sph_status deformation_and_stress(tl_csph *m, long n, sph_error *err) {
     tl_iact_plane_strain(F, dim);
     memcpy(m->F + 9 * a, F, sizeof F);
   }
+  SPH_TRY(sph_domain_exchange(m->sim->domain, m->F, 9, err));
   if (ne > n) /* the images' F mirror their sources' */
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  SPH_TRY(sph_domain_exchange(m->sim->domain, m->F, 9, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];

@@ -176,10 +176,15 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   sph_sim *sim = m->sim;
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
-  refresh_images(m);
   /* over MPI ranks the sweep reads the ghosts' p and Q (or P), which their
-   * owners compute */
+   * owners compute; images of ghosts mirror the ghosts' p, F, H and J */
   SPH_TRY(sph_domain_exchange(sim->domain, m->p, 3, err));
+  SPH_TRY(tl_image_sources(sim, &m->ref, m->F, 9, err));
+  if (m->fields == TL_JST_PFHJ)
+    SPH_TRY(tl_image_sources(sim, &m->ref, m->H, 9, err));
+  if (m->fields != TL_JST_PF)
+    SPH_TRY(tl_image_sources(sim, &m->ref, m->J, 1, err));
+  refresh_images(m);
   compute_stress(m, (long)m->ref.n_img, 0);
   if (m->force == TL_JST_CONSERVATIVE)
     SPH_TRY(sph_domain_exchange(sim->domain, m->ref.Qt, 9, err));
@@ -480,7 +485,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .cp = m->ref.cp,
                      .h = sim->dp,
                      .project = jproj,
-                     .exchange_u = 1};
+                     .exchange_u = !m->ref.sync_images};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
   SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
