@@ -149,11 +149,15 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                             "symmetry planes (mirror images) do not run over "
                             "MPI ranks yet with %s; run without mpirun",
                             sim->method->name);
-    if (np < 32) {
-      planes[np] =
-          (sph_domain_plane){.at = bc->select.at, .axis = bc->select.axis};
-      memcpy(planes[np++].n, bc->select.normal, sizeof planes->n);
-    }
+    if (np == (int)(sizeof planes / sizeof *planes))
+      return sph_node_error(bcs && k < bcs->count ? bcs->items[k] : s->root,
+                            err, SPH_ERR_UNSUPPORTED,
+                            "more than %d symmetry planes do not run over "
+                            "MPI ranks; run without mpirun",
+                            np);
+    planes[np] =
+        (sph_domain_plane){.at = bc->select.at, .axis = bc->select.axis};
+    memcpy(planes[np++].n, bc->select.normal, sizeof planes->n);
   }
   if (s->output.checkpoint_every > 0.0 &&
       sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
