@@ -116,6 +116,8 @@ void sph_domain_destroy(sph_domain *d) {
   free(d->all_off);
   free(d->all_gidx);
   free(d->gbuf);
+  free(d->counts);
+  free(d->offs);
   free(d->sums);
   sph_domain_dyn_destroy(d->dyn);
   free(d);
@@ -303,28 +305,24 @@ static sph_status exchange_plan(sph_domain *d, const int *owner,
   return SPH_OK;
 }
 
-/* rank 0 learns every rank's owned storage indices (the gather's map) and
- * holds a receive buffer of the largest share (`cap`: a dynamic domain's
- * owned particles never exceed it), not of the whole set */
-static sph_status gather_plan(sph_domain *d, size_t N, size_t cap,
-                              sph_error *err) {
+/* rank 0 learns every rank's owned storage indices (the gather's map) */
+static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
   int R = d->size;
   int fail = 0;
   if (d->rank == 0) {
     d->all_count = malloc((size_t)R * sizeof(int));
     d->all_off = malloc(((size_t)R + 1) * sizeof(int));
+    d->counts = malloc((size_t)R * sizeof(int));
+    d->offs = malloc((size_t)R * sizeof(int));
     d->all_gidx = malloc((N ? N : 1) * sizeof(int64_t));
-    fail = !d->all_count || !d->all_off || !d->all_gidx;
+    d->gbuf = malloc(9 * (N ? N : 1) * sizeof(double));
+    fail = !d->all_count || !d->all_off || !d->counts || !d->offs ||
+           !d->all_gidx || !d->gbuf;
   }
   sph_status st = fail ? sph_error_set(err, SPH_ERR_NOMEM, "gather") : SPH_OK;
   SPH_TRY(sph_domain_agree(d, st, err));
   sph_domain_gather_map(d);
-  size_t share = cap ? cap : 1;
-  for (int q = 1; d->rank == 0 && q < R; ++q)
-    share = (size_t)d->all_count[q] > share ? (size_t)d->all_count[q] : share;
-  if (d->rank == 0 && !(d->gbuf = malloc(9 * share * sizeof(double))))
-    st = sph_error_set(err, SPH_ERR_NOMEM, "gather");
-  return sph_domain_agree(d, st, err);
+  return SPH_OK;
 }
 
 void sph_domain_gather_map(sph_domain *d) {
@@ -439,7 +437,7 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
     st = owned_set(all, d, cap > d->n ? cap : d->n, &mine, err);
   st = sph_domain_agree(d, st, err);
   if (st == SPH_OK)
-    st = gather_plan(d, N, cap, err);
+    st = gather_plan(d, N, err);
   if (st == SPH_OK && dynamic)
     st = sph_domain_dyn_create(d, N, axis, cut, err);
   st = sph_domain_agree(d, st, err);
@@ -570,29 +568,6 @@ sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   return e.code != SPH_OK ? e.code : SPH_ERR_IO;
 }
 
-/* rank 0 receives the `nc` values (of `size` bytes) of each rank's n
- * owned particles, a rank at a time, and puts them at their storage index
- * in dst (NULL: received and dropped) */
-static void gather_to_root(sph_domain *d, const void *src, int n, void *dst,
-                           int nc, MPI_Datatype type, size_t size) {
-  if (d->rank != 0) {
-    MPI_Send(src, nc * n, type, 0, 11, MPI_COMM_WORLD);
-    return;
-  }
-  size_t w = (size_t)nc * size;
-  for (int q = 0; q < d->size; ++q) {
-    const char *from = src;
-    if (q > 0) {
-      MPI_Recv(d->gbuf, nc * d->all_count[q], type, q, 11, MPI_COMM_WORLD,
-               MPI_STATUS_IGNORE);
-      from = (const char *)d->gbuf;
-    }
-    const int64_t *g = d->all_gidx + d->all_off[q];
-    for (int k = 0; dst && k < d->all_count[q]; ++k)
-      memcpy((char *)dst + w * (size_t)g[k], from + w * (size_t)k, w);
-  }
-}
-
 void sph_domain_gather_select(sph_domain *d, unsigned long fields) {
   if (d)
     d->gathered = fields;
@@ -613,15 +588,30 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
         f == SPH_FIELD_VOLUME0 || !(d->gathered & 1ul << f))
       continue;
     int nc = sph_field_components((sph_field)f);
-    if (d->rank == 0 && st == SPH_OK)
-      st = sph_particles_require(all, (sph_field)f, err);
-    gather_to_root(d, local->field[f], (int)local->n,
-                   d->rank == 0 && st == SPH_OK ? all->field[f] : NULL, nc,
-                   MPI_DOUBLE, sizeof(double));
+    if (d->rank == 0) {
+      for (int q = 0; q < d->size; ++q) {
+        d->counts[q] = nc * d->all_count[q];
+        d->offs[q] = nc * d->all_off[q];
+      }
+      if (st == SPH_OK)
+        st = sph_particles_require(all, (sph_field)f, err);
+    }
+    MPI_Gatherv(local->field[f], nc * (int)local->n, MPI_DOUBLE, d->gbuf,
+                d->counts, d->offs, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (d->rank == 0 && st == SPH_OK) {
+      size_t N = all->n, w = (size_t)nc;
+      for (size_t k = 0; k < N; ++k)
+        memcpy(all->field[f] + w * (size_t)d->all_gidx[k], d->gbuf + w * k,
+               w * sizeof(double));
+    }
   }
-  gather_to_root(d, local->flags, (int)local->n,
-                 d->rank == 0 ? all->flags : NULL, 1, MPI_UINT32_T,
-                 sizeof(uint32_t));
+  MPI_Gatherv(local->flags, (int)local->n, MPI_UINT32_T, d->gbuf, d->all_count,
+              d->all_off, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  if (d->rank == 0) {
+    const uint32_t *fl = (const uint32_t *)d->gbuf;
+    for (size_t k = 0; k < all->n; ++k)
+      all->flags[d->all_gidx[k]] = fl[k];
+  }
   d->seconds += MPI_Wtime() - t0;
   return sph_domain_agree(d, st, err);
 }

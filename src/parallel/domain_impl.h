@@ -28,7 +28,8 @@ struct sph_domain {
   sph_particles *all; /* rank 0: the whole set */
   int *all_count, *all_off; /* rank 0: owned per rank (doubles: scaled) */
   int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
-  double *gbuf;             /* rank 0: 9 per particle of the largest share */
+  double *gbuf;             /* rank 0: 9 per particle, gathered */
+  int *counts, *offs;       /* rank 0: per-gather counts and offsets */
   unsigned long gathered;   /* fields gathered to rank 0 (bit 1ul << f) */
   double seconds;           /* in exchanges, reductions and gathers */
   double sent, messages;    /* doubles and messages the exchanges sent */
