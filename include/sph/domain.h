@@ -121,10 +121,14 @@ int sph_domain_migrates(const sph_domain *d);
 
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
 sph_particles *sph_domain_global(const sph_domain *d);
-/* Gathers every allocated field and the flags of `local` into rank 0's
- * whole set, each particle at its storage index of the serial run. */
+/* Gathers the fields of `local` among those selected (every field until
+ * sph_domain_gather_select) and the flags into rank 0's whole set, each
+ * particle at its storage index of the serial run. */
 sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
                              sph_error *err);
+/* The fields (bit 1ul << f) rank 0's outputs read from the whole set: only
+ * these are allocated there and gathered. */
+void sph_domain_gather_select(sph_domain *d, unsigned long fields);
 
 /* ---- updated-Lagrangian runs (src/parallel/domain_dynamic.c) ----------
  * Their neighbourhoods change, so a dynamic domain is partitioned like the

@@ -146,6 +146,15 @@ sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
                               sph_error *err);
 void sph_verdict_destroy(sph_verdict *v);
 
+/* The fields the indicators and the momenta read besides the reference
+ * positions and volumes (bit 1ul << f): over MPI ranks rank 0 gathers
+ * these. */
+#define SPH_VERDICT_FIELDS                                                     \
+  (1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_VELOCITY |                     \
+   1ul << SPH_FIELD_STRESS | 1ul << SPH_FIELD_JACOBIAN |                       \
+   1ul << SPH_FIELD_MASS | 1ul << SPH_FIELD_PRESSURE |                         \
+   1ul << SPH_FIELD_VON_MISES)
+
 /* Updates the indicators from a frame (after method->derive); fails only
  * when the neighbour lists cannot grow. */
 sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *frame,

@@ -475,6 +475,7 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
     d->rank = world_rank;
     d->size = world_size;
     d->dim = all->dim;
+    d->gathered = ~0ul;
     d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
     if (!d->sums)
       st = sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
@@ -700,6 +701,11 @@ sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   return e.code != SPH_OK ? e.code : SPH_ERR_IO;
 }
 
+void sph_domain_gather_select(sph_domain *d, unsigned long fields) {
+  if (d)
+    d->gathered = fields;
+}
+
 sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
                              sph_error *err) {
   if (!d)
@@ -711,7 +717,8 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
     sph_domain_gather_map(d);
   for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
     /* the reference positions and volumes never change */
-    if (!local->field[f] || f == SPH_FIELD_POSITION0 || f == SPH_FIELD_VOLUME0)
+    if (!local->field[f] || f == SPH_FIELD_POSITION0 ||
+        f == SPH_FIELD_VOLUME0 || !(d->gathered & 1ul << f))
       continue;
     int nc = sph_field_components((sph_field)f);
     if (d->rank == 0) {
@@ -788,6 +795,9 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
                              sph_error *err) {
   (void)d, (void)local, (void)err;
   return SPH_OK;
+}
+void sph_domain_gather_select(sph_domain *d, unsigned long fields) {
+  (void)d, (void)fields;
 }
 
 #endif

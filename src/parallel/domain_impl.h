@@ -31,6 +31,7 @@ struct sph_domain {
   int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
   double *gbuf;             /* rank 0: 9 per particle, gathered */
   int *counts, *offs;       /* rank 0: per-gather counts and offsets */
+  unsigned long gathered;   /* fields gathered to rank 0 (bit 1ul << f) */
   double seconds;           /* in exchanges, reductions and gathers */
   double sent, messages;    /* doubles and messages the exchanges sent */
   double *sums;             /* 16 per rank: sph_domain_sum's gather */
