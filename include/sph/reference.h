@@ -67,7 +67,13 @@ void sph_reference_observe(sph_reference *r, const sph_frame *frame);
 int sph_reference_state(sph_reference *r, sph_state_array *arr);
 
 /* Errors of the derived fields (velocity, first Piola-Kirchhoff stress,
- * displacement x - X) at the sim's time. */
+ * displacement x - X) at the sim's time; over MPI ranks rank 0 gathers the
+ * fields they read, SPH_REFERENCE_FIELDS (bit 1ul << f), besides the
+ * reference positions and volumes. */
+#define SPH_REFERENCE_FIELDS                                                   \
+  (1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_VELOCITY |                     \
+   1ul << SPH_FIELD_DISPLACEMENT | 1ul << SPH_FIELD_PK1 |                      \
+   1ul << SPH_FIELD_DEFGRAD)
 void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
                           sph_reference_error *e);
 

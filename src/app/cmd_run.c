@@ -204,10 +204,12 @@ static int piece_sink(const sph_sim *sim, const sph_sink *sink) {
 
 /* The fields rank 0's outputs read from the whole set over MPI ranks: the
  * verdict's and momenta's, the frames' positions, J and colour, the
- * probes' fields, a period reference's positions (the VTK pieces are
- * written per rank). */
-static unsigned long whole_fields(const sph_scene *s) {
+ * probes' fields, a reference's (the VTK pieces are written per rank). */
+static unsigned long whole_fields(const sph_sim *sim) {
+  const sph_scene *s = sim->scene;
   unsigned long f = SPH_VERDICT_FIELDS | 1ul << SPH_FIELD_POSITION;
+  if (sim->reference)
+    f |= SPH_REFERENCE_FIELDS;
   if (s->output.png.enabled)
     f |= 1ul << SPH_FIELD_JACOBIAN | 1ul << s->output.png.color_field;
   for (size_t k = 0; k < s->output.nprobes; ++k)
@@ -361,7 +363,7 @@ int sph_cmd_run(int argc, char **argv) {
   sph_status st = SPH_OK;
   char dir[1024];
   /* rank 0's view of a distributed run: every particle, gathered */
-  sph_domain_gather_select(sim->domain, whole_fields(scene));
+  sph_domain_gather_select(sim->domain, whole_fields(sim));
   sph_sim view = *sim;
   if (sim->domain && root)
     view.ps = sph_domain_global(sim->domain);
