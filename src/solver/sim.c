@@ -121,7 +121,6 @@ static sph_status check_memory(const sph_scene *scene, double support,
  * far: refused, the same on every rank, before anything is written. */
 static sph_status distribute(sph_sim *sim, sph_error *err) {
   const sph_scene *s = sim->scene;
-  const sph_node *out = sph_node_child(s->root, "output");
   const sph_node *bcs = sph_node_child(s->root, "boundaries");
   if (!sim->method->distributed) {
     const sph_node *name = sph_node_child(s->method, "name");
@@ -143,16 +142,6 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                             err, SPH_ERR_UNSUPPORTED,
                             "symmetry planes (mirror images) do not run over "
                             "MPI ranks yet; run without mpirun");
-  if (s->output.checkpoint_every > 0.0 &&
-      sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
-    const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;
-    return sph_node_error(ck ? ck : s->root, err, SPH_ERR_UNSUPPORTED,
-                          "checkpoints over MPI ranks are not written yet "
-                          "for %s, whose particles migrate between ranks; "
-                          "drop output.checkpoint_every or run without "
-                          "mpirun",
-                          sim->method->name);
-  }
   if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
     return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
   return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,
