@@ -24,22 +24,6 @@ rings=(run colliding_rings --quiet --set bodies.0.particles.spacing=0.002
 bar=(run bar_ul_csph --quiet --set time.end=0.3 --set output.every=0.05
   --set output.png=false --set output.checkpoint_every=0.05 --set "$fields")
 
-# every file the uninterrupted run wrote, the same bytes (but the timings
-# in summary.json and the command line in scene_used.yaml)
-same_files() { # label, uninterrupted folder, resumed folder
-  local n=0 f b
-  for f in "$2"/*; do
-    b=${f#"$2/"}
-    case $b in summary.json | scene_used.yaml | checkpoint_*) continue ;; esac
-    cmp -s "$f" "$3/$b" || fail "$1: $b differs from the uninterrupted run's"
-    n=$((n + 1))
-  done
-  ls "$3" | grep -q '\.part$' && fail "$1: temporary files left"
-  grep -q '"completed": true' "$3/summary.json" || fail "$1: not completed"
-  echo "$1: $n files compared"
-}
-rank_of() { pgrep -P "$1" | tail -1; } # a rank mpirun (pid $1) started
-
 # name, scene args...: the uninterrupted run, then kill -9 of a rank and
 # --resume
 killed_and_resumed() {
@@ -51,18 +35,14 @@ killed_and_resumed() {
     fail "$name: no particle migrated"
   "${mpi[@]}" -np 2 "$sph" "$@" --out "$work/$name.killed" >/dev/null 2>&1 &
   pid=$!
-  while [ ! -f "$work/$name.killed/checkpoint_b.sphm" ] && kill -0 $pid 2>/dev/null; do
-    sleep 0.02
-  done
-  victim=$(rank_of $pid)
-  [ -n "$victim" ] && kill -9 "$victim"
+  victim=$(kill_rank_when "$work/$name.killed/checkpoint_b.sphm" $pid)
   wait $pid
   rc=$?
   [ -n "$victim" ] || { fail "$name: the run ended before a rank was killed"; return; }
   [ $rc -ne 0 ] || fail "$name kill -9: mpirun exit 0"
   "${mpi[@]}" -np 2 "$sph" "$@" --resume "$work/$name.killed" >"$work/log" 2>&1 ||
     { fail "$name: resume after kill -9: $(tail -3 "$work/log")"; return; }
-  same_files "$name kill -9, resumed" "$work/$name" "$work/$name.killed"
+  resumed_like "$name kill -9, resumed" "$work/$name" "$work/$name.killed"
 }
 killed_and_resumed rings "${rings[@]}"
 killed_and_resumed bar "${bar[@]}"
@@ -87,7 +67,7 @@ grep -Eq '"migrated": [1-9]' "$work/term/summary.json" &&
 grep -E '"(migrated|rebalances)"' "$work/term/summary.json"
 "${mpi[@]}" -np 2 "$sph" "${rings[@]}" --resume "$work/term" >"$work/log" 2>&1 ||
   fail "resume after SIGTERM: $(tail -3 "$work/log")"
-same_files "rings SIGTERM to mpirun, resumed" "$work/rings" "$work/term"
+resumed_like "rings SIGTERM to mpirun, resumed" "$work/rings" "$work/term"
 
 # another rank count: refused, nothing changed
 before=$(ls -l --time-style=+%s.%N "$work/term" | md5sum)
