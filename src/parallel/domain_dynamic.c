@@ -49,11 +49,6 @@ struct sph_domain_dyn {
   int resumed; /* the next rebuild sends the checkpoint's ghosts */
 };
 
-/* doubles of a checkpoint's domain state: the rank count, the packed
- * width, the 5 counters, the cut tree (axis and cut, R + 1 each), the send
- * counts (R) and the send list (room for cap) */
-static size_t ckpt_len(size_t R, size_t cap) { return 9 + 3 * R + cap; }
-
 size_t sph_domain_dyn_capacity(size_t N, int R) {
   /* owned with the imbalance allowed, and as many ghosts (more ghosts than
    * owned particles: more ranks than useful) */
@@ -113,6 +108,11 @@ sph_domain_moves sph_domain_moves_of(const sph_domain *d) {
 }
 
 #ifdef SPH_HAVE_MPI
+
+/* doubles of a checkpoint's domain state: the rank count, the packed
+ * width, the 5 counters, the cut tree (axis and cut, R + 1 each), the send
+ * counts (R) and the send list (room for cap) */
+static size_t ckpt_len(size_t R, size_t cap) { return 9 + 3 * R + cap; }
 
 sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
                                  const double *cut, sph_error *err) {
