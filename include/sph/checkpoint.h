@@ -27,7 +27,12 @@
  * removed before its pieces are rewritten: a checkpoint exists only once
  * its manifest does, and the one before stays whole until then. A resume
  * needs the same rank count (the partition is the same) and takes the
- * newest manifest whose every piece holds. */
+ * newest manifest whose every piece holds. When the particles migrate
+ * between ranks (ul-sph, ul-csph) a piece's particle count is the rank's
+ * owned count at that step and two arrays follow the method's:
+ * "particles", each owned particle packed whole (sph_domain_checkpoint),
+ * and "domain", the cut tree, counters and halo plan; --resume puts them
+ * back instead of the set-up's partition. */
 #ifndef SPH_CHECKPOINT_H
 #define SPH_CHECKPOINT_H
 

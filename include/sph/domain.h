@@ -116,7 +116,8 @@ double sph_domain_seconds(const sph_domain *d);
 void sph_domain_traffic(const sph_domain *d, double *values, double *messages);
 
 /* Whether particles migrate between ranks (an updated-Lagrangian run; 0
- * for NULL): their checkpoints are not written yet. */
+ * for NULL): a checkpoint piece then holds its rank's owned particles and
+ * domain state (sph_domain_checkpoint). */
 int sph_domain_migrates(const sph_domain *d);
 
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
@@ -162,6 +163,26 @@ sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
 sph_status sph_domain_exchange_many(sph_domain *d, double *const *fields,
                                     const int *ncomp, int count,
                                     sph_error *err);
+/* Checkpoints of a dynamic domain (returns 0 for a fixed one or NULL, else
+ * 1): in buffers the domain holds, the first n owned particles packed with
+ * every field, id, body, flags, storage index and tracked array
+ * (*particles, *np doubles) and the domain's own state: the cut tree, the
+ * counters of sph_domain_moves_of and the halo plan of the last rebuild
+ * (*state, *ns doubles). With fill they are packed from ps (between
+ * steps, for writing), else they are the room a piece's arrays are read
+ * into (n at most sph_domain_capacity), then put in place by
+ * sph_domain_resume. */
+int sph_domain_checkpoint(sph_domain *d, const sph_particles *ps, size_t n,
+                          int fill, double **particles, size_t *np,
+                          double **state, size_t *ns);
+/* After a piece's arrays were read into those buffers: its n owned
+ * particles in their order and the domain's state in place (ps->n = n), so
+ * the partition is the checkpoint's, not a new RCB; the next
+ * sph_domain_rebuild (the method's restore) then sends the ghosts of the
+ * checkpoint's halo plan instead of migrating. SPH_ERR_IO when the state
+ * does not fit this run. */
+sph_status sph_domain_resume(sph_domain *d, sph_particles *ps, size_t n,
+                             sph_error *err);
 /* Over the run and all ranks: particles migrated, re-balances, rebuilds,
  * the largest halo (particles sent per exchange, all ranks) and the most
  * ghosts a rank held (zeros for a fixed domain). */

@@ -533,8 +533,7 @@ int sph_cmd_run(int argc, char **argv) {
       if (sinks[i].ops->flush && (root || piece_sink(sim, &sinks[i])))
         st = sinks[i].ops->flush(&sinks[i], &err);
     st = sph_domain_agree(sim->domain, st, &err);
-    /* (ranks whose particles migrate stop without one, not written yet) */
-    if (st == SPH_OK && !sph_domain_migrates(sim->domain))
+    if (st == SPH_OK)
       st = sph_checkpoint_write(dir, sim, verdict, index, &err);
   } else {
     stopped = 0;

@@ -152,6 +152,24 @@ static void put_calls(writer *w, const sph_sim *sim) {
   }
 }
 
+/* The arrays of a checkpoint of n owned particles: the method's, the scene
+ * reference's, and over MPI ranks with migrating particles the domain's
+ * (its owned particles whole and its state; packed from the simulation
+ * when fill); returns their count. */
+static int state_arrays(const sph_sim *sim, size_t n, int fill,
+                        sph_state_array *arr) {
+  int na = sim->method->state((sph_sim *)sim, arr);
+  na += sph_reference_state(sim->reference, arr + na);
+  double *parts, *dom;
+  size_t np, nd;
+  if (sph_domain_checkpoint(sim->domain, sim->ps, n, fill, &parts, &np, &dom,
+                            &nd)) {
+    arr[na++] = (sph_state_array){"particles", parts, np};
+    arr[na++] = (sph_state_array){"domain", dom, nd};
+  }
+  return na;
+}
+
 /* A piece's identity in its manifest: its length and its stored CRC-32. */
 typedef struct piece_sum {
   uint64_t size;
@@ -165,9 +183,8 @@ static sph_status write_file(const char *path, const char *prev,
                              int next_output, piece_sum *sum, sph_error *err) {
   unsigned crc = 0;
   SPH_TRY(sph_checkpoint_scene_crc(sim->scene, &crc, err));
-  sph_state_array arr[SPH_MAX_STATE + 1];
-  int na = sim->method->state((sph_sim *)sim, arr);
-  na += sph_reference_state(sim->reference, arr + na);
+  sph_state_array arr[SPH_MAX_STATE + 3];
+  int na = state_arrays(sim, sim->ps->n, 1, arr);
   sph_atomic_file af;
   SPH_TRY(sph_atomic_open(&af, path, err));
   writer w = {af.f, crc32(0L, Z_NULL, 0), 0};
@@ -476,10 +493,15 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
     FAIL("written by scene '%s', not '%s'", h.scene, sim->scene->name);
   if (strcmp(h.method, sim->method->name))
     FAIL("written by method %s, not %s", h.method, sim->method->name);
-  if (h.particles != sim->ps->n)
+  /* a rank of migrating particles owns its piece's count */
+  size_t most = sph_domain_capacity(sim->domain, sim->ps);
+  int moves = sph_domain_migrates(sim->domain);
+  if (moves ? h.particles > most : h.particles != sim->ps->n)
     FAIL("holds %llu particles, the scene makes %zu%s",
-         (unsigned long long)h.particles, sim->ps->n,
-         m ? " for this rank" : "");
+         (unsigned long long)h.particles, moves ? most : sim->ps->n,
+         moves ? " at most for this rank"
+         : m   ? " for this rank"
+               : "");
   if (h.scene_crc != crc)
     FAIL("written for a different configuration of scene '%s' (its "
          "resolved settings differ; resume with the same scene and --set "
@@ -504,9 +526,12 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
          sim->ntimers + sim->nterms);
   if (!get(&r, calls, ncalls * sizeof *calls))
     FAIL("truncated call counts");
-  sph_state_array arr[SPH_MAX_STATE + 1];
-  int nm = sim->method->state(sim, arr);
-  nm += sph_reference_state(sim->reference, arr + nm);
+  sph_state_array arr[SPH_MAX_STATE + 3];
+  /* the arrays' lengths for the piece's owned count */
+  size_t n_run = sim->ps->n;
+  sim->ps->n = (size_t)h.particles;
+  int nm = state_arrays(sim, sim->ps->n, 0, arr);
+  sim->ps->n = n_run;
   if (!get(&r, &na, 4) || na != (uint32_t)nm)
     FAIL("holds %u state arrays, method %s has %d", na, h.method, nm);
   for (int i = 0; i < nm; ++i) {
@@ -527,6 +552,9 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
   /* everything checked: copy in */
   for (int i = 0; i < nm; ++i)
     get(&r, arr[i].data, arr[i].len * sizeof(double));
+  sph_error de;
+  if (sph_domain_resume(sim->domain, sim->ps, (size_t)h.particles, &de))
+    FAIL("%s", de.message);
   out->h = h;
   out->v = vv;
 #undef FAIL
@@ -564,12 +592,6 @@ static sph_status resume_distributed(const char *dir, sph_sim *sim,
                                      sph_error *err) {
   sph_domain *d = sim->domain;
   int rank = sph_domain_rank(d), ranks = sph_domain_size(d), order = 0;
-  if (sph_domain_migrates(d))
-    return sph_error_at(err, SPH_ERR_UNSUPPORTED, dir, 0, 0, NULL,
-                        "%s over MPI ranks writes no checkpoint yet (its "
-                        "particles migrate between ranks): nothing to "
-                        "resume",
-                        sim->method->name);
   char why[2][320] = {"", ""}, mpath[1100], piece[64], ppath[1200];
   if (rank == 0) { /* slots newest first, as digits base 3 (0: none) */
     manifest m[2];

@@ -5,7 +5,9 @@
  * bisection (the cut planes of the last partition) to their owner with all
  * their per-particle values, re-balancing by a new RCB of the current
  * positions when the count imbalance exceeds SPH_DOMAIN_IMBALANCE, and a
- * halo exchange of several arrays in one message per neighbour rank. Every
+ * halo exchange of several arrays in one message per neighbour rank; for
+ * checkpoints, a rank's owned particles packed with the cut tree and the
+ * halo plan, put back in place on --resume. Every
  * buffer is sized at set-up (or at the first rebuild, in the method's
  * set-up); a rank that would outgrow them fails with SPH_ERR_RANGE. */
 #include "parallel/domain_impl.h"
@@ -43,6 +45,8 @@ struct sph_domain_dyn {
   int *owner;    /* re-balance: N, by storage index */
   double migrated, rebalances, rebuilds;
   double halo_max, ghosts_max; /* the largest halo and ghost layer */
+  double *ckpt;                /* a checkpoint's domain state (ckpt_len) */
+  int resumed; /* the next rebuild sends the checkpoint's ghosts */
 };
 
 size_t sph_domain_dyn_capacity(size_t N, int R) {
@@ -71,6 +75,7 @@ void sph_domain_dyn_destroy(sph_domain_dyn *y) {
   free(y->X);
   free(y->keys);
   free(y->owner);
+  free(y->ckpt);
   free(y);
 }
 
@@ -104,6 +109,11 @@ sph_domain_moves sph_domain_moves_of(const sph_domain *d) {
 
 #ifdef SPH_HAVE_MPI
 
+/* doubles of a checkpoint's domain state: the rank count, the packed
+ * width, the 5 counters, the cut tree (axis and cut, R + 1 each), the send
+ * counts (R) and the send list (room for cap) */
+static size_t ckpt_len(size_t R, size_t cap) { return 9 + 3 * R + cap; }
+
 sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
                                  const double *cut, sph_error *err) {
   size_t R = (size_t)d->size, cap = sph_domain_dyn_capacity(N, d->size);
@@ -127,11 +137,12 @@ sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
   y->X = malloc(3 * N * sizeof *y->X);
   y->keys = malloc(N * sizeof *y->keys);
   y->owner = malloc(N * sizeof *y->owner);
+  y->ckpt = calloc(ckpt_len(R, cap), sizeof *y->ckpt);
   free(d->send_idx);
   d->send_idx = malloc(cap * sizeof *d->send_idx);
   if (!y->axis || !y->cut || !y->dest || !y->cs || !y->cr || !y->os ||
       !y->orr || !y->at || !y->box || !y->count || !y->displ || !y->allx ||
-      !y->X || !y->keys || !y->owner || !d->send_idx)
+      !y->X || !y->keys || !y->owner || !y->ckpt || !d->send_idx)
     return sph_error_set(err, SPH_ERR_NOMEM, "dynamic domain");
   memcpy(y->axis, axis, (R + 1) * sizeof *axis);
   memcpy(y->cut, cut, (R + 1) * sizeof *cut);
@@ -323,37 +334,13 @@ static sph_status migrate(sph_domain *d, sph_particles *ps, sph_error *err) {
   return SPH_OK;
 }
 
-/* the other ranks' particles in this rank's box widened by radius, as
- * ghosts after the owned ones; the halo plan of sph_domain_exchange */
-static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
+/* the ghosts of the send lists (cs, send_idx; k entries in all) to their
+ * ranks, after the owned particles; the halo plan of sph_domain_exchange */
+static sph_status send_ghosts(sph_domain *d, sph_particles *ps, size_t k,
                               sph_error *err) {
   sph_domain_dyn *y = d->dyn;
   int R = d->size, w = y->width;
   size_t n = d->n;
-  const double *x = ps->field[SPH_FIELD_POSITION];
-  double box[6] = {INFINITY,  INFINITY,  INFINITY,
-                   -INFINITY, -INFINITY, -INFINITY};
-  for (size_t a = 0; a < n; ++a)
-    for (int c = 0; c < 3; ++c) {
-      box[c] = fmin(box[c], x[3 * a + c] - radius);
-      box[3 + c] = fmax(box[3 + c], x[3 * a + c] + radius);
-    }
-  MPI_Allgather(box, 6, MPI_DOUBLE, y->box, 6, MPI_DOUBLE, MPI_COMM_WORLD);
-  size_t k = 0;
-  for (int q = 0; q < R; ++q) {
-    y->cs[q] = 0;
-    const double *b = y->box + 6 * q;
-    for (size_t a = 0; q != d->rank && a < n; ++a) {
-      const double *p = x + 3 * a;
-      if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] ||
-          p[1] > b[4] || p[2] > b[5])
-        continue;
-      if (k < y->cap)
-        d->send_idx[k] = (int32_t)a;
-      ++k;
-      y->cs[q]++;
-    }
-  }
   MPI_Alltoall(y->cs, 1, MPI_INT, y->cr, 1, MPI_INT, MPI_COMM_WORLD);
   y->os[0] = y->orr[0] = 0;
   for (int q = 0; q < R; ++q) {
@@ -389,6 +376,40 @@ static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
   return SPH_OK;
 }
 
+/* the other ranks' particles in this rank's box widened by radius, as
+ * ghosts after the owned ones */
+static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
+                              sph_error *err) {
+  sph_domain_dyn *y = d->dyn;
+  int R = d->size;
+  size_t n = d->n;
+  const double *x = ps->field[SPH_FIELD_POSITION];
+  double box[6] = {INFINITY,  INFINITY,  INFINITY,
+                   -INFINITY, -INFINITY, -INFINITY};
+  for (size_t a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c) {
+      box[c] = fmin(box[c], x[3 * a + c] - radius);
+      box[3 + c] = fmax(box[3 + c], x[3 * a + c] + radius);
+    }
+  MPI_Allgather(box, 6, MPI_DOUBLE, y->box, 6, MPI_DOUBLE, MPI_COMM_WORLD);
+  size_t k = 0;
+  for (int q = 0; q < R; ++q) {
+    y->cs[q] = 0;
+    const double *b = y->box + 6 * q;
+    for (size_t a = 0; q != d->rank && a < n; ++a) {
+      const double *p = x + 3 * a;
+      if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] ||
+          p[1] > b[4] || p[2] > b[5])
+        continue;
+      if (k < y->cap)
+        d->send_idx[k] = (int32_t)a;
+      ++k;
+      y->cs[q]++;
+    }
+  }
+  return send_ghosts(d, ps, k, err);
+}
+
 sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
                               sph_error *err) {
   if (!d || !d->dyn)
@@ -411,6 +432,13 @@ sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
     return sph_error_set(err, SPH_ERR_ARG,
                          "domain: the particle fields changed after set-up");
   }
+  if (y->resumed) { /* a checkpoint's owned particles: its ghosts, no moves */
+    y->resumed = 0;
+    memcpy(y->cs, d->send_count, (size_t)d->size * sizeof *y->cs);
+    SPH_TRY(send_ghosts(d, ps, d->nsend, err));
+    d->seconds += MPI_Wtime() - t0;
+    return SPH_OK;
+  }
   /* re-balance when the most loaded rank owns too many */
   int n = (int)d->n, most = 0;
   MPI_Allgather(&n, 1, MPI_INT, y->count, 1, MPI_INT, MPI_COMM_WORLD);
@@ -430,6 +458,91 @@ sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
   y->halo_max = fmax(y->halo_max, halo);
   y->ghosts_max = fmax(y->ghosts_max, sph_domain_max(d, (double)d->ng));
   d->seconds += MPI_Wtime() - t0;
+  return SPH_OK;
+}
+
+/* ---- checkpoints --------------------------------------------------------
+ */
+
+int sph_domain_checkpoint(sph_domain *d, const sph_particles *ps, size_t n,
+                          int fill, double **particles, size_t *np,
+                          double **state, size_t *ns) {
+  if (!d || !d->dyn)
+    return 0;
+  sph_domain_dyn *y = d->dyn;
+  size_t R = (size_t)d->size, w = (size_t)y->width;
+  n = n < y->cap ? n : y->cap;
+  *particles = d->buf;
+  *np = w * n;
+  *state = y->ckpt;
+  *ns = ckpt_len(R, y->cap);
+  if (!fill)
+    return 1;
+  for (size_t a = 0; a < n; ++a)
+    pack(d, ps, a, d->buf + w * a);
+  double *o = y->ckpt;
+  memset(o, 0, *ns * sizeof *o);
+  double head[7] = {(double)R,   (double)w,   y->migrated,  y->rebalances,
+                    y->rebuilds, y->halo_max, y->ghosts_max};
+  memcpy(o, head, sizeof head);
+  double *ax = o + 7, *cut = ax + R + 1, *sc = cut + R + 1, *si = sc + R;
+  for (size_t s = 1; s < R; ++s) { /* the cuts s = 1 .. R - 1 */
+    ax[s] = (double)y->axis[s];
+    cut[s] = y->cut[s];
+  }
+  for (size_t q = 0; q < R; ++q)
+    sc[q] = (double)d->send_count[q];
+  for (size_t k = 0; k < d->nsend; ++k)
+    si[k] = (double)d->send_idx[k];
+  return 1;
+}
+
+sph_status sph_domain_resume(sph_domain *d, sph_particles *ps, size_t n,
+                             sph_error *err) {
+  if (!d || !d->dyn)
+    return SPH_OK;
+  sph_domain_dyn *y = d->dyn;
+  size_t R = (size_t)d->size, w = (size_t)y->width, k = 0;
+  const double *o = y->ckpt;
+  const double *ax = o + 7, *cut = ax + R + 1, *sc = cut + R + 1, *si = sc + R;
+  int ok = o[0] == (double)R && o[1] == (double)w && n <= y->cap &&
+           sc[d->rank] == 0.0;
+  for (size_t s = 1; ok && s < R; ++s)
+    ok = ax[s] >= 0.0 && ax[s] < (double)d->dim && isfinite(cut[s]);
+  for (size_t q = 0; ok && q < R; ++q) {
+    ok = sc[q] >= 0.0 && sc[q] <= (double)y->cap;
+    k += ok ? (size_t)sc[q] : 0;
+  }
+  ok = ok && k <= y->cap;
+  for (size_t j = 0; ok && j < k; ++j)
+    ok = si[j] >= 0.0 && si[j] < (double)n;
+  for (size_t a = 0; ok && a < n; ++a) {
+    int64_t g;
+    memcpy(&g, d->buf + w * a, sizeof g);
+    ok = g >= 0 && (size_t)g < y->N;
+  }
+  if (!ok)
+    return sph_error_set(err, SPH_ERR_IO,
+                         "its domain state does not fit this run (rank "
+                         "count, fields or particle indices)");
+  for (size_t a = 0; a < n; ++a)
+    unpack(d, ps, a, d->buf + w * a);
+  d->n = ps->n = n;
+  y->migrated = o[2];
+  y->rebalances = o[3];
+  y->rebuilds = o[4];
+  y->halo_max = o[5];
+  y->ghosts_max = o[6];
+  for (size_t s = 1; s < R; ++s) {
+    y->axis[s] = (int)ax[s];
+    y->cut[s] = cut[s];
+  }
+  for (size_t q = 0; q < R; ++q)
+    d->send_count[q] = (int)sc[q];
+  for (size_t j = 0; j < k; ++j)
+    d->send_idx[j] = (int32_t)si[j];
+  d->nsend = k;
+  y->resumed = 1;
   return SPH_OK;
 }
 
@@ -484,6 +597,20 @@ sph_status sph_domain_exchange_many(sph_domain *d, double *const *fields,
 }
 
 #else /* without MPI no domain is ever made */
+
+int sph_domain_checkpoint(sph_domain *d, const sph_particles *ps, size_t n,
+                          int fill, double **particles, size_t *np,
+                          double **state, size_t *ns) {
+  (void)d, (void)ps, (void)n, (void)fill, (void)particles, (void)np;
+  (void)state, (void)ns;
+  return 0;
+}
+
+sph_status sph_domain_resume(sph_domain *d, sph_particles *ps, size_t n,
+                             sph_error *err) {
+  (void)d, (void)ps, (void)n, (void)err;
+  return SPH_OK;
+}
 
 sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
                                  const double *cut, sph_error *err) {

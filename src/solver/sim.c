@@ -121,7 +121,6 @@ static sph_status check_memory(const sph_scene *scene, double support,
  * far: refused, the same on every rank, before anything is written. */
 static sph_status distribute(sph_sim *sim, sph_error *err) {
   const sph_scene *s = sim->scene;
-  const sph_node *out = sph_node_child(s->root, "output");
   const sph_node *bcs = sph_node_child(s->root, "boundaries");
   if (!sim->method->distributed) {
     const sph_node *name = sph_node_child(s->method, "name");
@@ -158,16 +157,6 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     planes[np] =
         (sph_domain_plane){.at = bc->select.at, .axis = bc->select.axis};
     memcpy(planes[np++].n, bc->select.normal, sizeof planes->n);
-  }
-  if (s->output.checkpoint_every > 0.0 &&
-      sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
-    const sph_node *ck = out ? sph_node_child(out, "checkpoint_every") : NULL;
-    return sph_node_error(ck ? ck : s->root, err, SPH_ERR_UNSUPPORTED,
-                          "checkpoints over MPI ranks are not written yet "
-                          "for %s, whose particles migrate between ranks; "
-                          "drop output.checkpoint_every or run without "
-                          "mpirun",
-                          sim->method->name);
   }
   if (np)
     return sph_domain_create_mirrored(&sim->domain, &sim->ps,

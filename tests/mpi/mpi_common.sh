@@ -5,7 +5,8 @@
 # (one thread a rank, oversubscribed; as root allowed), same_bytes A B (two
 # runs' files equal but for the timings) and refused SPH_ARGS... (exit 2 on
 # every rank of ${np:-2}, no folder made, the message $expect); fail MESSAGE
-# counts a failure found without check.
+# counts a failure found without check; resumed_like and kill_rank_when for
+# the checkpoint tests.
 # the output fields check_mpi.py compares (particle_id matches the particles)
 fields='output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]'
 work=$(mktemp -d)
@@ -45,6 +46,34 @@ refused() { # sph args...
     cat "$work/ref.txt"
     return 1
   fi
+}
+# resumed_like LABEL WHOLE RESUMED: every file the uninterrupted run wrote
+# in WHOLE has the same bytes in RESUMED (but the timings in summary.json,
+# the command line in scene_used.yaml and the checkpoints), no .part file
+# is left and the resumed run completed
+resumed_like() {
+  local n=0 f b
+  for f in "$2"/*; do
+    b=${f#"$2/"}
+    case $b in summary.json | scene_used.yaml | checkpoint_*) continue ;; esac
+    cmp -s "$f" "$3/$b" || fail "$1: $b differs from the uninterrupted run's"
+    n=$((n + 1))
+  done
+  ls "$3" | grep -q '\.part$' && fail "$1: temporary files left: $(ls "$3" | grep part)"
+  grep -q '"completed": true' "$3/summary.json" || fail "$1: not completed"
+  echo "$1: $n files compared"
+}
+rank_of() { pgrep -P "$1" | tail -1; } # a rank mpirun (pid $1) started
+# kill_rank_when FILE PID: once FILE is there, kill -9 of a rank of the
+# mpirun PID; prints the rank's pid (nothing when the run ended first)
+kill_rank_when() {
+  while [ ! -f "$1" ] && kill -0 "$2" 2>/dev/null; do
+    sleep 0.02
+  done
+  local victim
+  victim=$(rank_of "$2")
+  [ -n "$victim" ] && kill -9 "$victim"
+  echo "$victim"
 }
 frames_alike() { # serial dir, MPI dir
   for f in "$1"/frames/*.png; do

@@ -19,21 +19,8 @@ run=(run twisting_column --quiet --set 'method={name: tl-csph}'
   --set output.checkpoint_every=0.01
   --set 'output.fields=[pressure,velocity,displacement,von_mises,J,stress,body_id,particle_id]')
 
-# every file the uninterrupted run wrote, the same bytes (but the timings
-# in summary.json and the command line in scene_used.yaml)
-same_files() { # label, folder
-  local n=0 f b
-  for f in "$work/whole"/*; do
-    b=${f#"$work/whole/"}
-    case $b in summary.json | scene_used.yaml | checkpoint_*) continue ;; esac
-    cmp -s "$f" "$2/$b" || fail "$1: $b differs from the uninterrupted run's"
-    n=$((n + 1))
-  done
-  ls "$2" | grep -q '\.part$' && fail "$1: temporary files left: $(ls "$2" | grep part)"
-  grep -q '"completed": true' "$2/summary.json" || fail "$1: not completed"
-  echo "$1: $n files compared"
-}
-rank_of() { pgrep -P "$1" | tail -1; } # a rank mpirun (pid $1) started
+# every file the uninterrupted run wrote, the same bytes
+same_files() { resumed_like "$1" "$work/whole" "$2"; } # label, folder
 
 "${mpi[@]}" -np 2 "$sph" "${run[@]}" --out "$work/whole" >/dev/null 2>&1 ||
   { echo "FAIL: uninterrupted 2-rank run"; exit 1; }
@@ -45,11 +32,7 @@ grep -q '^ranks 2$' "$work/whole/checkpoint_a.sphm" || fail "manifest: $(cat "$w
 # kill -9 of a rank once two checkpoints are in place
 "${mpi[@]}" -np 2 "$sph" "${run[@]}" --out "$work/killed" >"$work/log" 2>&1 &
 pid=$!
-while [ ! -f "$work/killed/checkpoint_b.sphm" ] && kill -0 $pid 2>/dev/null; do
-  sleep 0.02
-done
-victim=$(rank_of $pid)
-[ -n "$victim" ] && kill -9 "$victim"
+victim=$(kill_rank_when "$work/killed/checkpoint_b.sphm" $pid)
 wait $pid
 rc=$?
 [ -n "$victim" ] || fail "kill -9: the run ended before a rank could be killed"

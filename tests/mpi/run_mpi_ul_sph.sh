@@ -7,7 +7,8 @@
 # the 3-rank cut crosses the left ring, so particles migrate and the ranks
 # re-balance (summary.json counts them); the same rank count twice writes
 # the same bytes; the stretched plate with its clamped base on 2 and 4 ranks
-# equals its serial run too. Usage: run_mpi_ul_sph.sh SPH SOURCE_DIR
+# equals its serial run too, and on 4 ranks resumes from its checkpoint to
+# the same bytes. Usage: run_mpi_ul_sph.sh SPH SOURCE_DIR
 set -u
 sph=$1
 src=$2
@@ -57,9 +58,16 @@ done
 plate_moved() { grep -Eq '"migrated": [1-9]' "$work/plate4/summary.json"; }
 check "plate np 4 migrates" plate_moved
 
-# its checkpoints are not written yet: refused before anything is written
-expect="checkpoints over MPI ranks are not written yet for ul-sph"
-check "checkpoints refused" refused "${plate[@]}" \
-  --set output.checkpoint_every=0.001
+# its checkpoint at 0.002 s (after hundreds of migrations and re-balances):
+# --resume on 4 ranks gives the uninterrupted run's bytes (the clamped
+# base's particle sets follow the restored partition)
+resumed_plate() {
+  "${mpi[@]}" -np 4 "$sph" "${plate[@]}" --set output.checkpoint_every=0.002 \
+    --out "$work/plate4c" >/dev/null &&
+    "${mpi[@]}" -np 4 "$sph" "${plate[@]}" --set output.checkpoint_every=0.002 \
+      --resume "$work/plate4c" >/dev/null &&
+    same_bytes "$work/plate4" "$work/plate4c"
+}
+check "plate np 4 resumed from a checkpoint" resumed_plate
 
 summary

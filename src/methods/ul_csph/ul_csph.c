@@ -393,6 +393,10 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
   ul_csph *m = sim->method_data;
   size_t n = m->ref.n, ne = m->ref.n_ext;
+  /* over MPI ranks (no images): the owned points, also while a checkpoint
+   * is read (the ghosts' come from their owners) */
+  if (sim->domain)
+    n = ne = sim->ps->n;
   out[0] = (sph_state_array){"x", m->x, 3 * n};
   out[1] = (sph_state_array){"p", m->p, 3 * n};
   out[2] = (sph_state_array){"F", m->F, 9 * n};

@@ -57,6 +57,16 @@ static double max_speed(const ul_sph *m, int global) {
   return sqrt(global ? sph_domain_max(m->sim->domain, vmax2) : vmax2);
 }
 
+/* over MPI ranks: sph_domain_rebuild, then the owned and ghost counts and
+ * the terms' particle sets */
+static sph_status redistribute(ul_sph *m, sph_error *err) {
+  sph_sim *sim = m->sim;
+  SPH_TRY(sph_domain_rebuild(sim->domain, sim->ps, sim->kernel.support, err));
+  m->n = sim->ps->n;
+  m->ng = sph_domain_ghosts(sim->domain);
+  return sph_sim_terms_renumber(sim, err);
+}
+
 /* neighbours of `pos` and their pair geometry, without touching the time */
 static sph_status configuration_build(ul_sph *m, const double *pos,
                                       sph_error *err) {
@@ -64,12 +74,8 @@ static sph_status configuration_build(ul_sph *m, const double *pos,
   double t0 = sph_wtime();
   const sph_kernel *k = &sim->kernel;
   /* over MPI ranks: migration, re-balance, the ghosts of this rebuild */
-  if (sim->domain && pos == m->x) {
-    SPH_TRY(sph_domain_rebuild(sim->domain, sim->ps, k->support, err));
-    m->n = sim->ps->n;
-    m->ng = sph_domain_ghosts(sim->domain);
-    SPH_TRY(sph_sim_terms_renumber(sim, err));
-  }
+  if (sim->domain && pos == m->x)
+    SPH_TRY(redistribute(m, err));
   SPH_TRY(sph_neighbors_build(m->nl, pos, m->n + m->ng, sim->scene->dimension,
                               k->support, NULL, SPH_PAIRS_ALL, err));
   /* a distributed run sums pairs in the serial run's order */
@@ -484,7 +490,7 @@ static void ul_sph_energy(sph_sim *sim, double *kinetic, double *strain) {
 
 static int ul_sph_state(sph_sim *sim, sph_state_array *out) {
   ul_sph *m = sim->method_data;
-  size_t n = m->n;
+  size_t n = sim->ps->n; /* m->n but while a checkpoint is read */
   int k = 0;
   out[k++] = (sph_state_array){"x", m->x, 3 * n};
   out[k++] = (sph_state_array){"v", m->v, 3 * n};
@@ -503,6 +509,13 @@ static int ul_sph_state(sph_sim *sim, sph_state_array *out) {
 
 static sph_status ul_sph_restore(sph_sim *sim, sph_error *err) {
   ul_sph *m = sim->method_data;
+  /* over MPI ranks: the checkpoint's owned particles, its ghosts and their
+   * positions at the last update */
+  if (sim->domain) {
+    SPH_TRY(redistribute(m, err));
+    int three = 3;
+    SPH_TRY(sph_domain_exchange_many(sim->domain, &m->xcfg, &three, 1, err));
+  }
   return configuration_build(m, m->xcfg, err);
 }
 
