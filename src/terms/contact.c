@@ -124,10 +124,15 @@ static sph_status between_bodies(contact *ct, const sph_sim *sim,
       memcpy(ct->xc + 3 * nc, x + 3 * a, 3 * sizeof *x);
       ct->bc[nc++] = body[a];
     }
+  /* a search failing on one rank (positions no longer finite) fails on
+   * all, or the others would wait in the next exchange */
+  sph_status st =
+      nc < 2 ? SPH_OK
+             : sph_neighbors_build(ct->nl, ct->xc, nc, ct->dim, ct->radius,
+                                   ct->bc, SPH_PAIRS_OTHER_BODY, err);
+  SPH_TRY(sph_domain_agree(ct->dom, st, err));
   if (nc < 2)
     return SPH_OK;
-  SPH_TRY(sph_neighbors_build(ct->nl, ct->xc, nc, ct->dim, ct->radius, ct->bc,
-                              SPH_PAIRS_OTHER_BODY, err));
   const sph_neighbors *nl = ct->nl;
   /* the lists name particles, in the serial run's order over ranks */
   for (size_t s = 0; s < nl->count; ++s)
