@@ -73,16 +73,20 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
 sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
                                     sph_error *err);
 
-/* The coefficients a point's W~1 gradient and (when `laplacian`) corrected
- * Laplacian slots are evaluated from, SPH_CORRECTION_COEFS per point, so
- * that a slot (a -> b) is evaluated again where a's neighbourhood is not
- * whole (a ghost of a distributed run, its coefficients from its owner):
- * sph_correction_slot gives the same bits as the sweeps above. */
+/* The coefficients a point's corrected gradient slots (kind SPH_GRAD_W1:
+ * W~1; SPH_GRAD_CORRECTED_W0: L grad W~0, seed 004 eq. 10-14) and (when
+ * `laplacian`) corrected Laplacian slots are evaluated from,
+ * SPH_CORRECTION_COEFS per point, so that a slot (a -> b) is evaluated
+ * again where a's neighbourhood is not whole (a ghost of a distributed run,
+ * its coefficients from its owner): sph_correction_slot gives the same bits
+ * as the sweeps above. */
 #define SPH_CORRECTION_COEFS 20
-sph_status sph_correction_coefficients(const sph_cloud *c, int laplacian,
+sph_status sph_correction_coefficients(const sph_cloud *c,
+                                       sph_gradient_kind kind, int laplacian,
                                        double *coef, sph_error *err);
-/* grad W~1_b(X_a) and Lap W~_b(X_a) of slot (a -> b) from coef, a's. */
-void sph_correction_slot(const sph_cloud *c, const double *coef, size_t a,
-                         size_t b, double grad[3], double *lap);
+/* The gradient of kind and Lap W~_b(X_a) of slot (a -> b) from coef, a's. */
+void sph_correction_slot(const sph_cloud *c, sph_gradient_kind kind,
+                         const double *coef, size_t a, size_t b, double grad[3],
+                         double *lap);
 
 #endif

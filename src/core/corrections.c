@@ -209,11 +209,71 @@ static inline void w1_slot(const sph_cloud *c, const w1_coef *w, size_t a,
              w->alpha * lin * g[k];
 }
 
+/* The raw or W~0 gradients of a's slots (into grad when not NULL, before
+ * the correction), the self gradient gs and the correction La (identity
+ * for UNCORRECTED) of the moment M = sum V g (x) (x_b - x_a); S and gam the
+ * Shepard sum and grad S / S when not NULL (W~0). -1 when M is singular.
+ * The slots, when given, end corrected: La g. */
+static int corrected_point(const sph_cloud *c, sph_gradient_kind kind, size_t a,
+                           double rmin, double *grad, double gs[3],
+                           double La[9], double *S_out, double gam_out[3]) {
+  const sph_neighbors *nl = c->nl;
+  double S = 1.0, gam[3] = {0, 0, 0}, M[9] = {0};
+  int w0 = kind == SPH_GRAD_CORRECTED_W0;
+  sph_mat3_identity(La);
+  gs[0] = gs[1] = gs[2] = 0.0;
+  if (w0) {
+    shepard(c, a, &S, gam);
+    /* W~0_a(x) = W(x - x_a) / S(x): at x_a only S varies */
+    for (int k = 0; k < 3; ++k)
+      gs[k] = -sph_kernel_eval(c->kernel, 0.0) * gam[k] / S;
+  }
+  if (S_out) {
+    *S_out = S;
+    memcpy(gam_out, gam, sizeof gam);
+  }
+  for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
+    size_t b = (size_t)nl->index[s];
+    double rab[3], r, g[3];
+    pair_vector(c, a, b, rab, &r);
+    sph_kernel_gradient(c->kernel, rab, r, g);
+    if (w0) {
+      double Wb = sph_kernel_eval(c->kernel, r);
+      for (int k = 0; k < 3; ++k)
+        g[k] = (g[k] - Wb * gam[k]) / S;
+    }
+    if (grad)
+      memcpy(grad + 3 * s, g, sizeof g);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        M[3 * i + j] -= c->volume[b] * g[i] * rab[j];
+  }
+  if (kind == SPH_GRAD_UNCORRECTED)
+    return 0;
+  if (invert_block(M, c->dim, rmin, La) < rmin)
+    return -1;
+  for (size_t s = nl->offset[a]; grad && s < nl->offset[a + 1]; ++s)
+    sph_mat3_vec(La, grad + 3 * s, grad + 3 * s);
+  sph_mat3_vec(La, gs, gs);
+  return 0;
+}
+
+/* corrected grad W~0_b(x_a) of slot (a -> b) from a's S, gamma and L */
+static inline void w0_slot(const sph_cloud *c, const double *co, size_t a,
+                           size_t b, double out[3]) {
+  double rab[3], r, g[3];
+  pair_vector(c, a, b, rab, &r);
+  sph_kernel_gradient(c->kernel, rab, r, g);
+  double Wb = sph_kernel_eval(c->kernel, r);
+  for (int k = 0; k < 3; ++k)
+    g[k] = (g[k] - Wb * co[1 + k]) / co[0];
+  sph_mat3_vec(co + 4, g, out);
+}
+
 sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
                                    double *grad, double *grad_self, double *L,
                                    sph_error *err) {
   const sph_neighbors *nl = c->nl;
-  int dim = c->dim;
   long n = (long)c->n, bad = n;
   double rmin = rcond_min(c);
   if ((int)kind < SPH_GRAD_UNCORRECTED || kind > SPH_GRAD_W1)
@@ -240,45 +300,14 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
         gs[k] = (w.dalpha[k] + w.alpha * w.beta[k]) * W0;
       for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s)
         w1_slot(c, &w, (size_t)a, (size_t)nl->index[s], grad + 3 * s);
-    } else {
-      /* raw or W~0 gradients and the moment M = sum V g (x) (x_b - x_a) */
-      double S = 1.0, gam[3] = {0, 0, 0}, M[9] = {0};
-      int w0 = kind == SPH_GRAD_CORRECTED_W0;
-      if (w0) {
-        shepard(c, (size_t)a, &S, gam);
-        /* W~0_a(x) = W(x - x_a) / S(x): at x_a only S varies */
-        for (int k = 0; k < 3; ++k)
-          gs[k] = -sph_kernel_eval(c->kernel, 0.0) * gam[k] / S;
-      }
-      for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
-        size_t b = (size_t)nl->index[s];
-        double rab[3], r, g[3];
-        pair_vector(c, (size_t)a, b, rab, &r);
-        sph_kernel_gradient(c->kernel, rab, r, g);
-        if (w0) {
-          double Wb = sph_kernel_eval(c->kernel, r);
-          for (int k = 0; k < 3; ++k)
-            g[k] = (g[k] - Wb * gam[k]) / S;
-        }
-        if (grad)
-          memcpy(grad + 3 * s, g, sizeof g);
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            M[3 * i + j] -= c->volume[b] * g[i] * rab[j];
-      }
-      if (kind != SPH_GRAD_UNCORRECTED) {
-        if (invert_block(M, dim, rmin, La) < rmin) {
-          mark_bad(&bad, a);
-          if (grad)
-            clear_slots(nl, (size_t)a, 3, grad);
-          if (grad_self)
-            memset(grad_self + 3 * a, 0, 3 * sizeof *grad_self);
-          continue;
-        }
-        for (size_t s = nl->offset[a]; grad && s < nl->offset[a + 1]; ++s)
-          sph_mat3_vec(La, grad + 3 * s, grad + 3 * s);
-        sph_mat3_vec(La, gs, gs);
-      }
+    } else if (corrected_point(c, kind, (size_t)a, rmin, grad, gs, La, NULL,
+                               NULL)) {
+      mark_bad(&bad, a);
+      if (grad)
+        clear_slots(nl, (size_t)a, 3, grad);
+      if (grad_self)
+        memset(grad_self + 3 * a, 0, 3 * sizeof *grad_self);
+      continue;
     }
     if (grad_self)
       memcpy(grad_self + 3 * a, gs, sizeof gs);
@@ -474,17 +503,28 @@ sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
   return SPH_OK;
 }
 
-sph_status sph_correction_coefficients(const sph_cloud *c, int laplacian,
+sph_status sph_correction_coefficients(const sph_cloud *c,
+                                       sph_gradient_kind kind, int laplacian,
                                        double *coef, sph_error *err) {
   long n = (long)c->n, bad = n;
   double rmin = rcond_min(c);
   int lap_bad = 0;
+  if (kind != SPH_GRAD_W1 && kind != SPH_GRAD_CORRECTED_W0)
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "slot coefficients of gradient kind %d", (int)kind);
 #pragma omp parallel for schedule(static) reduction(| : lap_bad)
   for (long a = 0; a < n; ++a) {
     double *co = coef + SPH_CORRECTION_COEFS * a;
-    w1_coef w;
-    int wrong = w1_coefficients(c, (size_t)a, rmin, &w) != 0;
-    memcpy(co, &w, sizeof w);
+    int wrong;
+    if (kind == SPH_GRAD_W1) {
+      w1_coef w;
+      wrong = w1_coefficients(c, (size_t)a, rmin, &w) != 0;
+      memcpy(co, &w, sizeof w);
+    } else { /* S, gamma, L: 13 */
+      double gs[3];
+      wrong = corrected_point(c, kind, (size_t)a, rmin, NULL, gs, co + 4, co,
+                              co + 1) != 0;
+    }
     double sol[4] = {0};
     if (laplacian && laplacian_solution(c, (size_t)a, rmin, sol)) {
       wrong = 1;
@@ -502,10 +542,15 @@ sph_status sph_correction_coefficients(const sph_cloud *c, int laplacian,
   return SPH_OK;
 }
 
-void sph_correction_slot(const sph_cloud *c, const double *coef, size_t a,
-                         size_t b, double grad[3], double *lap) {
-  w1_coef w;
-  memcpy(&w, coef, sizeof w);
-  w1_slot(c, &w, a, b, grad);
+void sph_correction_slot(const sph_cloud *c, sph_gradient_kind kind,
+                         const double *coef, size_t a, size_t b, double grad[3],
+                         double *lap) {
+  if (kind == SPH_GRAD_W1) {
+    w1_coef w;
+    memcpy(&w, coef, sizeof w);
+    w1_slot(c, &w, a, b, grad);
+  } else {
+    w0_slot(c, coef, a, b, grad);
+  }
   *lap = laplacian_slot(c, coef + 16, a, b);
 }

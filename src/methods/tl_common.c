@@ -378,16 +378,18 @@ sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
 }
 
 sph_status tl_ghost_slots(const sph_sim *sim, const tl_reference *ref,
-                          const sph_cloud *cloud, const size_t *rev,
-                          double *grad, double *lap, sph_error *err) {
+                          const sph_cloud *cloud, sph_gradient_kind kind,
+                          const size_t *rev, double *grad, double *lap,
+                          sph_error *err) {
   if (!sim->domain)
     return SPH_OK;
   size_t ne = ref->n_ext, ni = ref->n_img, nc = SPH_CORRECTION_COEFS;
   double *coef = calloc(nc * ne + 1, sizeof *coef);
   double *part = calloc(9 * ne + 1, sizeof *part);
   sph_status st =
-      coef && part ? sph_correction_coefficients(cloud, lap != NULL, coef, err)
-                   : sph_error_set(err, SPH_ERR_NOMEM, "ghost coefficients");
+      coef && part
+          ? sph_correction_coefficients(cloud, kind, lap != NULL, coef, err)
+          : sph_error_set(err, SPH_ERR_NOMEM, "ghost coefficients");
   st = sph_domain_agree(sim->domain, st, err);
   /* the ghosts' from their owners, in parts of at most 9 */
   for (size_t j = 0; st == SPH_OK && j < nc; j += 9) {
@@ -405,7 +407,8 @@ sph_status tl_ghost_slots(const sph_sim *sim, const tl_reference *ref,
       double l;
       if (b < ni)
         continue;
-      sph_correction_slot(cloud, coef + nc * b, b, a, grad + 3 * rev[k], &l);
+      sph_correction_slot(cloud, kind, coef + nc * b, b, a, grad + 3 * rev[k],
+                          &l);
       if (lap)
         lap[rev[k]] = l;
     }

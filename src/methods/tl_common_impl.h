@@ -12,6 +12,7 @@
 
 #include "integrators/integrator_impl.h"
 #include "methods/tl_iact.h"
+#include "sph/corrections.h"
 #include "sph/material.h"
 #include "sph/neighbors.h"
 #include "sph/sim.h"
@@ -101,13 +102,14 @@ sph_status tl_reference_reverse_fill(const tl_reference *ref, size_t *rev,
 /* Over MPI ranks (else nothing): a ghost's list is partial, so its slots
  * toward this rank's particles, rev[k] for each slot k = (a -> b) of a
  * particle a with a ghost b, are evaluated from b's coefficients, which its
- * owner computes (sph_correction_coefficients): grad W~1_a(X_b) into grad
- * (3 per slot) and, when lap is not NULL, Lap W~_a(X_b) into lap; the
- * cloud's rows are the particles' (n_img). */
-struct sph_cloud;
+ * owner computes (sph_correction_coefficients): the corrected gradient of
+ * kind (W~1 or L grad W~0) at X_b into grad (3 per slot) and, when lap is
+ * not NULL, Lap W~_a(X_b) into lap; the cloud's rows are the particles'
+ * (n_img). */
 sph_status tl_ghost_slots(const sph_sim *sim, const tl_reference *ref,
-                          const struct sph_cloud *cloud, const size_t *rev,
-                          double *grad, double *lap, sph_error *err);
+                          const sph_cloud *cloud, sph_gradient_kind kind,
+                          const size_t *rev, double *grad, double *lap,
+                          sph_error *err);
 
 /* Corrected gradient grad_b(X_a) of slot k of particle a (set-up use). */
 void tl_reference_gradient(const tl_reference *ref, size_t a, size_t k,

@@ -424,6 +424,45 @@ START_TEST(corrected_kernels) {
 }
 END_TEST
 
+/* A slot evaluated from its point's coefficients (what a ghost's owner
+ * sends over MPI ranks) has the sweep's bits, W~1 and L grad W~0 alike, and
+ * the Laplacian slot too. */
+START_TEST(slot_coefficients_repeat_the_sweeps) {
+  static const sph_gradient_kind kinds[2] = {SPH_GRAD_W1,
+                                             SPH_GRAD_CORRECTED_W0};
+  for (int dim = 2; dim <= 3; ++dim)
+    for (int kk = 0; kk < 2; ++kk) {
+      cloud_data d;
+      make_cloud(&d, dim, dim == 2 ? 10 : 6, 0.25, SPH_KERNEL_CUBIC);
+      size_t count = d.nl->count;
+      double *g = calloc(3 * count + 3, sizeof *g);
+      double *lap = calloc(count + 1, sizeof *lap);
+      double *co = calloc(SPH_CORRECTION_COEFS * d.n, sizeof *co);
+      ck_assert_int_eq(
+          sph_correction_gradient(&d.c, kinds[kk], g, NULL, NULL, NULL),
+          SPH_OK);
+      ck_assert_int_eq(sph_correction_laplacian(&d.c, lap, NULL), SPH_OK);
+      ck_assert_int_eq(
+          sph_correction_coefficients(&d.c, kinds[kk], 1, co, NULL), SPH_OK);
+      size_t differ = 0;
+      for (size_t a = 0; a < d.n; ++a)
+        for (size_t k = d.nl->offset[a]; k < d.nl->offset[a + 1]; ++k) {
+          double gs[3], ls;
+          sph_correction_slot(&d.c, kinds[kk], co + SPH_CORRECTION_COEFS * a, a,
+                              (size_t)d.nl->index[k], gs, &ls);
+          differ += memcmp(gs, g + 3 * k, sizeof gs) != 0;
+          differ += memcmp(&ls, lap + k, sizeof ls) != 0;
+        }
+      ck_assert_msg(differ == 0, "dim %d kind %d: %zu of %zu slots differ", dim,
+                    (int)kinds[kk], differ, 2 * count);
+      free(g);
+      free(lap);
+      free(co);
+      release(&d);
+    }
+}
+END_TEST
+
 static void assert_all_finite(const double *v, size_t n) {
   for (size_t i = 0; i < n; ++i)
     ck_assert(isfinite(v[i]));
@@ -511,6 +550,7 @@ int main(void) {
   tcase_add_test(tc, kernel_gradients_match_finite_differences);
   tcase_add_test(tc, corrected_laplacian);
   tcase_add_test(tc, corrected_kernels);
+  tcase_add_test(tc, slot_coefficients_repeat_the_sweeps);
   tcase_add_test(tc, singular_clouds_are_reported);
   suite_add_tcase(s, tc);
   return sph_test_run(s);

@@ -246,20 +246,20 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
                      .kernel = &sim->kernel};
   double *g = NULL, *w = NULL, *wself = NULL, *lap = NULL;
   size_t *rev = NULL;
+  sph_gradient_kind kind = first_order ? SPH_GRAD_W1 : SPH_GRAD_CORRECTED_W0;
   sph_status st;
   if ((st = alloc_zero(&g, 3 * count, err)) != SPH_OK ||
       (st = alloc_zero(&w, count, err)) != SPH_OK ||
       (st = alloc_zero(&wself, ne, err)) != SPH_OK ||
       (need_lap && (st = alloc_zero(&lap, count, err)) != SPH_OK) ||
       (st = tl_reference_reverse_slots(ref, &rev, err)) != SPH_OK ||
-      (st = sph_correction_gradient(
-           &cloud, first_order ? SPH_GRAD_W1 : SPH_GRAD_CORRECTED_W0, g, NULL,
-           NULL, err)) != SPH_OK ||
+      (st = sph_correction_gradient(&cloud, kind, g, NULL, NULL, err)) !=
+          SPH_OK ||
       (st = sph_correction_kernel(&cloud, first_order ? 1 : 0, w, wself,
                                   err)) != SPH_OK ||
       (need_lap &&
        (st = sph_correction_laplacian(&cloud, lap, err)) != SPH_OK) ||
-      (st = tl_ghost_slots(sim, ref, &cloud, rev, g, lap, err)) != SPH_OK)
+      (st = tl_ghost_slots(sim, ref, &cloud, kind, rev, g, lap, err)) != SPH_OK)
     goto done;
   for (size_t a = 0; a < cloud.n; ++a) {
     double *M = m->Mc + 9 * a;
@@ -330,11 +330,6 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "pair", &ws, err));
   m->bond = dg == 0;
   m->pair_speed = ws == 0;
-  if (sim->domain && corr == 1)
-    return sph_node_error(sph_node_child(opt, "correction"), err,
-                          SPH_ERR_UNSUPPORTED,
-                          "correction: zeroth_order does not run over MPI "
-                          "ranks yet (first_order does); run without mpirun");
   m->integrate = integ == 0 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
   SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.9, &m->cfl, err));
   /* both integrators are SSP with coefficient 1: stable up to the forward

@@ -414,7 +414,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
                                     m->fgrad_self, NULL, err));
     SPH_TRY(tl_reference_reverse_slots(&m->ref, &m->rev, err));
-    SPH_TRY(tl_ghost_slots(sim, &m->ref, &cloud, m->rev, m->fgrad, NULL, err));
+    SPH_TRY(tl_ghost_slots(sim, &m->ref, &cloud, SPH_GRAD_W1, m->rev, m->fgrad,
+                           NULL, err));
   }
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
