@@ -14,7 +14,8 @@
 # twice writes the same bytes; essential_bc lagrange is refused.
 # tl-bond (its ghosts' pair weights from their owners' coefficients, no
 # global sum) gives the serial files bit for bit but the energies (check_mpi.py
-# without --roundoff, as tl-csph), its zeroth-order correction is refused.
+# without --roundoff, as tl-csph), with the first- and the zeroth-order
+# correction (the ghosts' L grad W~0 from their owners' S, gamma and L).
 # Usage: run_mpi_tl_jst.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -37,6 +38,8 @@ compare symmetric twisting_column "$roundoff" 2 -- "${symmetric[@]}"
 compare eq31 punch "$roundoff" 2 -- "${punch[@]}" --set method.force=eq31 \
   --set time.end=0.003
 compare bond twisting_column_bond 1e-12 2 -- "${bond[@]}"
+compare bond0 twisting_column_bond 1e-12 2 3 -- "${bond[@]}" \
+  --set method.correction=zeroth_order
 
 # the same rank count and thread count: the same bytes
 check "punch np 2 again" "${mpi[@]}" -np 2 "$sph" "${punch[@]}" \
@@ -48,8 +51,5 @@ check "punch np 2 twice: identical files" same_bytes "$work/punch.np2" \
 expect="essential_bc: lagrange does not run over MPI ranks yet"
 check "essential_bc lagrange refused" refused "${punch[@]}" \
   --set method.essential_bc=lagrange
-expect="correction: zeroth_order does not run over MPI ranks yet"
-check "tl-bond zeroth_order refused" refused "${bond[@]}" \
-  --set method.correction=zeroth_order
 
 summary
