@@ -37,9 +37,9 @@ no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
 check "no stale pieces" no_stale
 
 # refusals: exit 2 on every rank, the folder never made
-expect="essential_bc: lagrange does not run over MPI ranks yet"
-check "symmetry planes as constraints refused" refused run swinging_cube \
-  --quiet --set method.essential_bc=lagrange
+expect="correction: zeroth_order does not run over MPI ranks yet"
+check "tl-bond zeroth_order refused" refused run twisting_column_bond \
+  --quiet --set method.correction=zeroth_order
 expect="more than useful"
 np=4 check "too many ranks refused" refused run twisting_column --quiet \
   --set 'method={name: tl-csph}' --set 'bodies.0.particles.count=[3,7,3]'
