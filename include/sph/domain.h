@@ -97,6 +97,10 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
 double sph_domain_min(sph_domain *d, double v);
 double sph_domain_max(sph_domain *d, double v);
 void sph_domain_sum(sph_domain *d, double *v, int count);
+/* The same for any count, chunk values at a time through work (the rank
+ * count times chunk doubles). */
+void sph_domain_sum_long(sph_domain *d, double *v, size_t count, double *work,
+                         size_t chunk);
 /* Root's value on every rank. */
 int sph_domain_bcast_int(sph_domain *d, int v);
 /* Rank 0 receives count values of every rank in rank order (out: count

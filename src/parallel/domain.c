@@ -668,6 +668,25 @@ void sph_domain_sum(sph_domain *d, double *v, int count) {
   }
 }
 
+void sph_domain_sum_long(sph_domain *d, double *v, size_t count, double *work,
+                         size_t chunk) {
+  if (!d || chunk == 0)
+    return;
+  double t0 = MPI_Wtime();
+  for (size_t off = 0; off < count; off += chunk) {
+    size_t m = count - off < chunk ? count - off : chunk;
+    MPI_Allgather(v + off, (int)m, MPI_DOUBLE, work, (int)m, MPI_DOUBLE,
+                  MPI_COMM_WORLD);
+    for (size_t c = 0; c < m; ++c) {
+      double s = 0.0;
+      for (int q = 0; q < d->size; ++q)
+        s += work[(size_t)q * m + c];
+      v[off + c] = s;
+    }
+  }
+  d->seconds += MPI_Wtime() - t0;
+}
+
 int sph_domain_bcast_int(sph_domain *d, int v) {
   if (d)
     MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -781,6 +800,10 @@ double sph_domain_min(sph_domain *d, double v) { return (void)d, v; }
 double sph_domain_max(sph_domain *d, double v) { return (void)d, v; }
 void sph_domain_sum(sph_domain *d, double *v, int count) {
   (void)d, (void)v, (void)count;
+}
+void sph_domain_sum_long(sph_domain *d, double *v, size_t count, double *work,
+                         size_t chunk) {
+  (void)d, (void)v, (void)count, (void)work, (void)chunk;
 }
 int sph_domain_bcast_int(sph_domain *d, int v) { return (void)d, v; }
 void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,

@@ -22,7 +22,13 @@
  * B.2 as printed forces the total momentum of a clamped body to evolve as
  * if it were free: the clamp's reaction becomes a uniform body force on the
  * whole body. It is therefore an option (`lagrange_momentum`), off by
- * default. */
+ * default.
+ *
+ * Over MPI ranks (issue 20) the boundary points, their rows W~_a(X_B) and
+ * densities are gathered to every rank at set-up; each rank sums its owned
+ * particles' share of K, of the interpolants and of H and Q, the shares are
+ * added in rank order, every rank solves the same system and corrects its
+ * owned particles. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -30,10 +36,12 @@
 #include <string.h>
 
 #include "sph/corrections.h"
+#include "sph/domain.h"
 #include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 #define LP_MAX_POINTS 4096
+#define LP_CHUNK 4096 /* values per reduction message */
 
 typedef struct lp_block {
   size_t n;     /* active points of this component */
@@ -44,13 +52,16 @@ typedef struct lp_block {
 } lp_block;
 
 typedef struct lagrange_projection {
-  size_t n; /* particles */
-  const double *X, *V, *rho0;
-  const sph_neighbors *nl;
+  size_t n; /* particles (this rank's owned ones over MPI ranks) */
+  const double *X, *V;
   double *w, *wself; /* W~_b(X_a) per slot, W~_a(X_a) */
   const sph_scene *scene;
+  sph_domain *dom;         /* NULL in a serial run */
+  double *work;            /* rank count x LP_CHUNK for the reductions */
   size_t nb;               /* boundary points */
-  size_t *pt;              /* their particles */
+  size_t *roff, *ridx;     /* row of each point: its owned particles a, */
+  double *rw;              /* self first, with W~_a(X_B) */
+  double *rho0;            /* reference density at each point */
   uint32_t *member;        /* which boundaries select each point */
   double *K;               /* nb x nb */
   double *target;          /* prescribed momentum at each point (3 nb) */
@@ -146,7 +157,6 @@ static void chol_solve(const double *L, size_t n, double *b, size_t stride) {
 static void lp_targets(lagrange_projection *lp, double t) {
   const sph_scene *s = lp->scene;
   for (size_t B = 0; B < lp->nb; ++B) {
-    size_t P = lp->pt[B];
     lp->mask[B] = 0u;
     for (int c = 0; c < 3; ++c)
       lp->target[3 * B + c] = 0.0;
@@ -156,7 +166,7 @@ static void lp_targets(lagrange_projection *lp, double t) {
       lp->mask[B] |= m;
       for (int c = 0; c < 3; ++c)
         if ((m & (1u << c)) && bc->kind == SPH_BC_VELOCITY)
-          lp->target[3 * B + c] = lp->rho0[P] * bc->value[c];
+          lp->target[3 * B + c] = lp->rho0[B] * bc->value[c];
     }
   }
 }
@@ -185,33 +195,32 @@ static sph_status lp_factorise(lagrange_projection *lp, sph_error *err) {
  * factor of S = Q - sum_c H_c^T Y_c. */
 static sph_status lp_schur(lagrange_projection *lp, const double *xm,
                            sph_error *err) {
-  const sph_neighbors *nl = lp->nl;
-  double vol = 0.0;
-  lp->xc[0] = lp->xc[1] = lp->xc[2] = 0.0;
+  double m[4] = {0.0, 0.0, 0.0, 0.0}; /* volume, first moment */
   for (size_t a = 0; a < lp->n; ++a) {
-    vol += lp->V[a];
+    m[0] += lp->V[a];
     for (int c = 0; c < 3; ++c)
-      lp->xc[c] += lp->V[a] * xm[3 * a + c];
+      m[1 + c] += lp->V[a] * xm[3 * a + c];
   }
+  sph_domain_sum(lp->dom, m, 4);
   for (int c = 0; c < 3; ++c)
-    lp->xc[c] /= vol > 0.0 ? vol : 1.0;
+    lp->xc[c] = m[1 + c] / (m[0] > 0.0 ? m[0] : 1.0);
   for (int c = 0; c < 3; ++c) {
     lp_block *b = &lp->blk[c];
     for (size_t i = 0; i < b->n; ++i) {
-      size_t P = lp->pt[b->pt[i]];
+      size_t B = b->pt[i];
       for (int j = 0; j < 6; ++j) {
-        double e[3];
-        global_dir(j, xm + 3 * P, lp->xc, e);
-        double h = lp->V[P] * lp->wself[P] * e[c];
-        for (size_t k = nl->offset[P]; k < nl->offset[P + 1]; ++k) {
-          size_t a = (size_t)nl->index[k];
+        double h = 0.0;
+        for (size_t k = lp->roff[B]; k < lp->roff[B + 1]; ++k) {
+          size_t a = lp->ridx[k];
+          double e[3];
           global_dir(j, xm + 3 * a, lp->xc, e);
-          h += lp->V[a] * lp->w[k] * e[c];
+          h += lp->V[a] * lp->rw[k] * e[c];
         }
         b->H[i * 6 + j] = h;
-        b->Y[i * 6 + j] = h;
       }
     }
+    sph_domain_sum_long(lp->dom, b->H, 6 * b->n, lp->work, LP_CHUNK);
+    memcpy(b->Y, b->H, 6 * b->n * sizeof *b->Y);
     for (int j = 0; j < 6; ++j)
       chol_solve(b->chol, b->n, b->Y + j, 6);
   }
@@ -225,6 +234,7 @@ static sph_status lp_schur(lagrange_projection *lp, const double *xm,
       for (int j = 0; j < 6; ++j)
         S[i * 6 + j] += lp->V[a] * sph_vec3_dot(e[i], e[j]);
   }
+  sph_domain_sum_long(lp->dom, S, 36, lp->work, LP_CHUNK);
   for (int c = 0; c < 3; ++c) {
     lp_block *b = &lp->blk[c];
     for (size_t k = 0; k < b->n; ++k)
@@ -235,14 +245,14 @@ static sph_status lp_schur(lagrange_projection *lp, const double *xm,
   return cholesky(S, 6, err);
 }
 
-/* Interpolated value of component c of f (3 per particle) at point B. */
+/* Interpolated value of component c of f (3 per particle) at point B
+ * (this rank's share over MPI ranks). */
 static double interp(const lagrange_projection *lp, size_t B, int c,
                      const double *f) {
-  size_t P = lp->pt[B];
-  double v = lp->V[P] * lp->wself[P] * f[3 * P + c];
-  for (size_t k = lp->nl->offset[P]; k < lp->nl->offset[P + 1]; ++k) {
-    size_t a = (size_t)lp->nl->index[k];
-    v += lp->V[a] * lp->w[k] * f[3 * a + c];
+  double v = 0.0;
+  for (size_t k = lp->roff[B]; k < lp->roff[B + 1]; ++k) {
+    size_t a = lp->ridx[k];
+    v += lp->V[a] * lp->rw[k] * f[3 * a + c];
   }
   return v;
 }
@@ -261,10 +271,11 @@ static sph_status lp_project(lagrange_projection *lp, double t,
   for (int c = 0; c < 3; ++c) {
     lp_block *b = &lp->blk[c];
     double *gam = lp->gam + c * lp->nb;
-    for (size_t i = 0; i < b->n; ++i) {
-      size_t B = b->pt[i];
-      gam[i] = (rates ? 0.0 : lp->target[3 * B + c]) - interp(lp, B, c, f);
-    }
+    for (size_t i = 0; i < b->n; ++i)
+      gam[i] = interp(lp, b->pt[i], c, f);
+    sph_domain_sum_long(lp->dom, gam, b->n, lp->work, LP_CHUNK);
+    for (size_t i = 0; i < b->n; ++i)
+      gam[i] = (rates ? 0.0 : lp->target[3 * b->pt[i] + c]) - gam[i];
     chol_solve(b->chol, b->n, gam, 1);
     if (lp->global)
       for (size_t i = 0; i < b->n; ++i)
@@ -293,10 +304,9 @@ static sph_status lp_project(lagrange_projection *lp, double t,
     lp_block *b = &lp->blk[c];
     const double *gam = lp->gam + c * lp->nb;
     for (size_t i = 0; i < b->n; ++i) {
-      size_t P = lp->pt[b->pt[i]];
-      f[3 * P + c] += lp->wself[P] * gam[i];
-      for (size_t k = lp->nl->offset[P]; k < lp->nl->offset[P + 1]; ++k)
-        f[3 * (size_t)lp->nl->index[k] + c] += lp->w[k] * gam[i];
+      size_t B = b->pt[i];
+      for (size_t k = lp->roff[B]; k < lp->roff[B + 1]; ++k)
+        f[3 * lp->ridx[k] + c] += lp->rw[k] * gam[i];
     }
   }
   return SPH_OK;
@@ -326,7 +336,11 @@ static void lp_destroy(sph_term *term) {
   }
   free(lp->w);
   free(lp->wself);
-  free(lp->pt);
+  free(lp->work);
+  free(lp->roff);
+  free(lp->ridx);
+  free(lp->rw);
+  free(lp->rho0);
   free(lp->member);
   free(lp->K);
   free(lp->target);
@@ -343,31 +357,214 @@ static const sph_term_ops lagrange_projection_ops = {
     .rates = lp_rates,
     .constrain = lp_constrain,
     .destroy = lp_destroy,
+    .distributed = 1,
 };
 
-/* K_BB' = sum_a V_a W~_a(X_B) W~_a(X_B'), through a dense scatter of row B. */
+/* K_BB' = sum_a V_a W~_a(X_B) W~_a(X_B'), through a dense scatter of row B
+ * (this rank's share, then added over the ranks). */
 static void lp_build_K(lagrange_projection *lp) {
-  const sph_neighbors *nl = lp->nl;
   size_t nb = lp->nb;
   double *row = lp->tmp;
   for (size_t B = 0; B < nb; ++B) {
-    size_t P = lp->pt[B];
-    row[P] = lp->wself[P];
-    for (size_t k = nl->offset[P]; k < nl->offset[P + 1]; ++k)
-      row[nl->index[k]] = lp->w[k];
+    for (size_t k = lp->roff[B]; k < lp->roff[B + 1]; ++k)
+      row[lp->ridx[k]] = lp->rw[k];
     for (size_t B2 = 0; B2 < nb; ++B2) {
-      size_t Q = lp->pt[B2];
-      double s = lp->V[Q] * row[Q] * lp->wself[Q];
-      for (size_t k = nl->offset[Q]; k < nl->offset[Q + 1]; ++k) {
-        size_t a = (size_t)nl->index[k];
-        s += lp->V[a] * row[a] * lp->w[k];
+      double s = 0.0;
+      for (size_t k = lp->roff[B2]; k < lp->roff[B2 + 1]; ++k) {
+        size_t a = lp->ridx[k];
+        s += lp->V[a] * row[a] * lp->rw[k];
       }
       lp->K[B * nb + B2] = s;
     }
-    row[P] = 0.0;
-    for (size_t k = nl->offset[P]; k < nl->offset[P + 1]; ++k)
-      row[nl->index[k]] = 0.0;
+    for (size_t k = lp->roff[B]; k < lp->roff[B + 1]; ++k)
+      row[lp->ridx[k]] = 0.0;
   }
+  sph_domain_sum_long(lp->dom, lp->K, nb * nb, lp->work, LP_CHUNK);
+}
+
+/* Which constraints select owned particle a (bit k: boundary k). */
+static uint32_t lp_member(const lagrange_projection *lp, const sph_sim *sim,
+                          size_t a) {
+  const sph_scene *s = lp->scene;
+  uint32_t m = 0;
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (is_constraint(&s->boundaries[k]) &&
+        sph_selection_contains(s, &s->boundaries[k].select, sim->ps->body[a],
+                               lp->X + 3 * a))
+      m |= 1u << k;
+  return m;
+}
+
+static sph_status lp_too_many(size_t nb, sph_error *err) {
+  return sph_error_set(err, SPH_ERR_UNSUPPORTED,
+                       "essential_bc: lagrange factorises a dense matrix "
+                       "over the boundary points; %zu points exceed the "
+                       "limit of %d (use essential_bc: direct)",
+                       nb, LP_MAX_POINTS);
+}
+
+/* Rows arrays for nb points and len entries. */
+static sph_status lp_alloc_rows(lagrange_projection *lp, size_t nb, size_t len,
+                                sph_error *err) {
+  lp->member = calloc(nb + 1, sizeof *lp->member);
+  lp->rho0 = calloc(nb + 1, sizeof *lp->rho0);
+  lp->roff = calloc(nb + 2, sizeof *lp->roff);
+  lp->ridx = malloc((len + 1) * sizeof *lp->ridx);
+  lp->rw = malloc((len + 1) * sizeof *lp->rw);
+  if (!lp->member || !lp->rho0 || !lp->roff || !lp->ridx || !lp->rw)
+    return sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+  return SPH_OK;
+}
+
+/* Boundary points of a serial run: every particle a constraint selects, in
+ * storage order, each with its row. */
+static sph_status lp_points_serial(lagrange_projection *lp, sph_sim *sim,
+                                   const sph_neighbors *nl, const double *rho0,
+                                   sph_error *err) {
+  size_t *pt = malloc((lp->n + 1) * sizeof *pt), len = 0;
+  uint32_t *mem = malloc((lp->n + 1) * sizeof *mem);
+  sph_status st = SPH_OK;
+  if (!pt || !mem) {
+    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+    goto done;
+  }
+  for (size_t a = 0; a < lp->n; ++a)
+    if ((mem[lp->nb] = lp_member(lp, sim, a))) {
+      len += 1 + nl->offset[a + 1] - nl->offset[a];
+      pt[lp->nb++] = a;
+    }
+  if (lp->nb > LP_MAX_POINTS) {
+    st = lp_too_many(lp->nb, err);
+    goto done;
+  }
+  if ((st = lp_alloc_rows(lp, lp->nb, len, err)) != SPH_OK)
+    goto done;
+  for (size_t B = 0; B < lp->nb; ++B) {
+    size_t P = pt[B], r = lp->roff[B];
+    lp->member[B] = mem[B];
+    lp->rho0[B] = rho0[P];
+    lp->ridx[r] = P;
+    lp->rw[r++] = lp->wself[P];
+    for (size_t k = nl->offset[P]; k < nl->offset[P + 1]; ++k) {
+      lp->ridx[r] = (size_t)nl->index[k];
+      lp->rw[r++] = lp->w[k];
+    }
+    lp->roff[B + 1] = r;
+  }
+done:
+  free(pt);
+  free(mem);
+  return st;
+}
+
+/* This rank's owned particle of storage index g (n when another's). */
+static size_t lp_owned(const int64_t *gidx, size_t n, int64_t g) {
+  size_t lo = 0, hi = n;
+  while (lo < hi) {
+    size_t mid = lo + (hi - lo) / 2;
+    if (gidx[mid] < g)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < n && gidx[lo] == g ? lo : n;
+}
+
+/* Boundary points over MPI ranks: the owners' selections, densities and
+ * rows (storage indices of the row's particles) are added over the ranks,
+ * each slot written by one rank only, so every rank holds them in storage
+ * order; a rank keeps the entries of its owned particles. */
+static sph_status lp_points_distributed(lagrange_projection *lp,
+                                        const sph_neighbors *nl, sph_sim *sim,
+                                        const double *rho0, sph_error *err) {
+  sph_domain *d = lp->dom;
+  const int64_t *gidx = sph_domain_storage_index(d);
+  size_t n = lp->n, nb = 0, len = 0;
+  double total = (double)n;
+  sph_domain_sum(d, &total, 1);
+  size_t N = (size_t)total;
+  double *sel = calloc(N + 1, sizeof *sel), *buf = NULL;
+  int64_t *bg = NULL;
+  sph_status st = SPH_OK;
+  if (!sel) {
+    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+    goto done;
+  }
+  for (size_t a = 0; a < n; ++a)
+    sel[gidx[a]] = (double)lp_member(lp, sim, a);
+  sph_domain_sum_long(d, sel, N, lp->work, LP_CHUNK);
+  for (size_t g = 0; g < N; ++g)
+    nb += sel[g] != 0.0;
+  if (nb > LP_MAX_POINTS) {
+    st = lp_too_many(nb, err);
+    goto done;
+  }
+  /* per point: storage index, row length and density */
+  bg = malloc((nb + 1) * sizeof *bg);
+  buf = calloc(2 * nb + 1, sizeof *buf);
+  if (!bg || !buf) {
+    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+    goto done;
+  }
+  nb = 0;
+  for (size_t g = 0; g < N; ++g)
+    if (sel[g] != 0.0)
+      bg[nb++] = (int64_t)g;
+  for (size_t B = 0; B < nb; ++B) {
+    size_t P = lp_owned(gidx, n, bg[B]);
+    if (P < n) {
+      buf[B] = (double)(1 + nl->offset[P + 1] - nl->offset[P]);
+      buf[nb + B] = rho0[P];
+    }
+  }
+  sph_domain_sum_long(d, buf, 2 * nb, lp->work, LP_CHUNK);
+  for (size_t B = 0; B < nb; ++B)
+    len += (size_t)buf[B];
+  if ((st = lp_alloc_rows(lp, nb, len, err)) != SPH_OK)
+    goto done;
+  lp->nb = nb;
+  for (size_t B = 0; B < nb; ++B) {
+    lp->member[B] = (uint32_t)sel[bg[B]];
+    lp->rho0[B] = buf[nb + B];
+    lp->roff[B + 1] = lp->roff[B] + (size_t)buf[B];
+  }
+  /* the rows: storage index then W~_a(X_B) of each entry */
+  free(buf);
+  if (!(buf = calloc(2 * len + 1, sizeof *buf))) {
+    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+    goto done;
+  }
+  for (size_t B = 0; B < nb; ++B) {
+    size_t P = lp_owned(gidx, n, bg[B]), r = lp->roff[B];
+    if (P == n)
+      continue;
+    buf[2 * r] = (double)gidx[P];
+    buf[2 * r++ + 1] = lp->wself[P];
+    for (size_t k = nl->offset[P]; k < nl->offset[P + 1]; ++k) {
+      buf[2 * r] = (double)gidx[nl->index[k]];
+      buf[2 * r++ + 1] = lp->w[k];
+    }
+  }
+  sph_domain_sum_long(d, buf, 2 * len, lp->work, LP_CHUNK);
+  size_t r = 0, start = 0;
+  for (size_t B = 0; B < nb; ++B) {
+    size_t end = lp->roff[B + 1];
+    lp->roff[B] = r;
+    for (size_t q = start; q < end; ++q) {
+      size_t a = lp_owned(gidx, n, (int64_t)buf[2 * q]);
+      if (a < n) {
+        lp->ridx[r] = a;
+        lp->rw[r++] = buf[2 * q + 1];
+      }
+    }
+    start = end;
+  }
+  lp->roff[nb] = r;
+done:
+  free(sel);
+  free(buf);
+  free(bg);
+  return st;
 }
 
 sph_status lagrange_projection_create(sph_sim *sim, const sph_cloud *cloud,
@@ -402,42 +599,26 @@ sph_status lagrange_projection_create(sph_sim *sim, const sph_cloud *cloud,
   lp->n = n;
   lp->X = cloud->x;
   lp->V = cloud->volume;
-  lp->rho0 = rho0;
-  lp->nl = cloud->nl;
   lp->scene = s;
+  lp->dom = sim->domain;
   lp->global = global;
   lp->w = malloc((cloud->nl->count + 1) * sizeof *lp->w);
   lp->wself = malloc((n + 1) * sizeof *lp->wself);
-  lp->pt = malloc((n + 1) * sizeof *lp->pt);
-  lp->member = calloc(n + 1, sizeof *lp->member);
   lp->tmp = calloc(n + 1, sizeof *lp->tmp);
-  if (!lp->w || !lp->wself || !lp->pt || !lp->member || !lp->tmp) {
+  if (lp->dom)
+    lp->work =
+        malloc((size_t)sph_domain_size(lp->dom) * LP_CHUNK * sizeof *lp->work);
+  if (!lp->w || !lp->wself || !lp->tmp || (lp->dom && !lp->work)) {
     st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
     goto fail;
   }
   if ((st = sph_correction_kernel(cloud, 1, lp->w, lp->wself, err)) != SPH_OK)
     goto fail;
   /* boundary points: every particle a constraint selects */
-  for (size_t a = 0; a < n; ++a) {
-    uint32_t m = 0;
-    for (size_t k = 0; k < s->nboundaries; ++k)
-      if (is_constraint(&s->boundaries[k]) &&
-          sph_selection_contains(s, &s->boundaries[k].select, sim->ps->body[a],
-                                 lp->X + 3 * a))
-        m |= 1u << k;
-    if (m) {
-      lp->member[lp->nb] = m;
-      lp->pt[lp->nb++] = a;
-    }
-  }
-  if (lp->nb > LP_MAX_POINTS) {
-    st = sph_error_set(err, SPH_ERR_UNSUPPORTED,
-                       "essential_bc: lagrange factorises a dense matrix "
-                       "over the boundary points; %zu points exceed the "
-                       "limit of %d (use essential_bc: direct)",
-                       lp->nb, LP_MAX_POINTS);
+  st = lp->dom ? lp_points_distributed(lp, cloud->nl, sim, rho0, err)
+               : lp_points_serial(lp, sim, cloud->nl, rho0, err);
+  if (st != SPH_OK)
     goto fail;
-  }
   size_t nb = lp->nb ? lp->nb : 1;
   lp->K = malloc(nb * nb * sizeof *lp->K);
   lp->target = malloc(3 * nb * sizeof *lp->target);

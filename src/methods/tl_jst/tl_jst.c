@@ -402,12 +402,6 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
              : m->force == TL_JST_EQ31       ? sweep_eq31
                                              : sweep_symmetric;
-  if (sim->domain && bc == 1)
-    return sph_node_error(sph_node_child(opt, "essential_bc"), err,
-                          SPH_ERR_UNSUPPORTED,
-                          "essential_bc: lagrange does not run over MPI ranks "
-                          "yet (essential_bc: direct does); run without "
-                          "mpirun");
   if (m->force == TL_JST_EQ31) {
     SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
     SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
