@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -259,12 +260,45 @@ static void bench_child(const bench_case *c, int threads, const char *dir,
  * process would not survive the next fork) and reads its size bytes of
  * out back; 1 when they all came, 0 when not (status: how the child
  * ended), -1 when no child could be started. */
+/* SIGINT, SIGTERM, SIGHUP and SIGPIPE (the reader of the output gone) end
+ * the case running, start no other, and the suite removes its folder
+ * before the signal ends it (bench_end_on_signal) */
+static volatile sig_atomic_t bench_signal, running_child;
+static const int bench_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+
+static void on_bench_signal(int signo) {
+  bench_signal = signo;
+  if (running_child > 0)
+    kill((pid_t)running_child, SIGTERM);
+}
+
+static void bench_catch_signals(void (*handler)(int)) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = handler;
+  sa.sa_flags = SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  for (size_t i = 0; i < sizeof bench_signals / sizeof *bench_signals; ++i)
+    sigaction(bench_signals[i], &sa, NULL);
+}
+
+static void remove_dir_files(const char *dir);
+
+static void bench_end_on_signal(const char *dir) {
+  int signo = bench_signal;
+  if (!signo)
+    return;
+  remove_dir_files(dir);
+  signal(signo, SIG_DFL);
+  raise(signo);
+}
+
 static int in_child(void (*work)(const void *ctx, void *out), const void *ctx,
                     void *out, size_t size, int *status, struct rusage *ru) {
   int fd[2];
-  if (pipe(fd) != 0)
-    return -1;
   fflush(NULL);
+  if (bench_signal || pipe(fd) != 0)
+    return -1;
   pid_t pid = fork();
   if (pid < 0) {
     close(fd[0]);
@@ -273,11 +307,15 @@ static int in_child(void (*work)(const void *ctx, void *out), const void *ctx,
   }
   if (pid == 0) {
     close(fd[0]);
+    bench_catch_signals(SIG_DFL);
     work(ctx, out);
     ssize_t w = write(fd[1], out, size);
     _exit(w == (ssize_t)size ? 0 : 1);
   }
   close(fd[1]);
+  running_child = pid;
+  if (bench_signal) /* it came between the fork and here */
+    kill(pid, SIGTERM);
   size_t got = 0;
   while (got < size) {
     ssize_t k = read(fd[0], (char *)out + got, size - got);
@@ -286,9 +324,9 @@ static int in_child(void (*work)(const void *ctx, void *out), const void *ctx,
     got += (size_t)k;
   }
   close(fd[0]);
-  if (wait4(pid, status, 0, ru) < 0)
-    return -1;
-  return got == size;
+  int waited = wait4(pid, status, 0, ru) >= 0;
+  running_child = 0;
+  return waited ? got == size : -1;
 }
 
 typedef struct case_job {
@@ -774,7 +812,10 @@ int sph_cmd_bench(int argc, char **argv) {
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   int thr[2] = {1, threads ? threads : (int)(cores > 0 ? cores : 1)};
   int nthr = thr[1] == 1 ? 1 : 2;
-  char dir[] = "/tmp/sph_bench_XXXXXX";
+  const char *tmp = getenv("TMPDIR");
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s/sph_bench_XXXXXX", tmp && *tmp ? tmp : "/tmp");
+  bench_catch_signals(on_bench_signal);
   if (!mkdtemp(dir)) {
     fprintf(stderr, "sph bench: cannot create a temporary folder: %s\n",
             strerror(errno));
@@ -787,6 +828,7 @@ int sph_cmd_bench(int argc, char **argv) {
   bench_case none = {"baseline", "twisting_column", {0}, 0, 0};
   bench_result base;
   bench_run(&none, 1, dir, &base);
+  bench_end_on_signal(dir);
   long baseline_kb = base.max_rss_kb;
   char thr2[32] = "";
   if (nthr > 1)
@@ -805,6 +847,7 @@ int sph_cmd_bench(int argc, char **argv) {
         double r = machine_rate(thr[t], k);
         speed[k][t] = r > speed[k][t] ? r : speed[k][t];
       }
+  bench_end_on_signal(dir);
   static const char *const what[2] = {"memory bandwidth (STREAM triad",
                                       "arithmetic (multiply-add chains"};
   static const char *const unit[2] = {"GB/s", "GFlop/s"};
@@ -834,6 +877,7 @@ int sph_cmd_bench(int argc, char **argv) {
                  strerror(errno));
       if (!r->threads)
         r->threads = thr[t];
+      bench_end_on_signal(dir);
       failed |= !r->ok;
       print_row(&cases[c], r, baseline_kb);
     }

@@ -5,6 +5,9 @@
 set -u
 sph=$1
 . "$(dirname "$0")/harness.sh"
+# the suite's folder goes under TMPDIR: this test's own
+export TMPDIR="$work/tmp"
+mkdir -p "$TMPDIR"
 
 if "$sph" bench --quick --json "$work/bench.json" >"$work/out" 2>&1; then
   ok
@@ -43,6 +46,15 @@ else
 fi
 "$sph" bench --bogus >/dev/null 2>&1
 [ $? -eq 2 ] && ok || bad "an unknown option: exit not 2"
-ls /tmp/sph_bench_* >/dev/null 2>&1 && bad "temporary folder left" || ok
+ls "$TMPDIR"/sph_bench_* >/dev/null 2>&1 && bad "temporary folder left" || ok
+# a reader that stops reading (SIGPIPE) and an interrupt (SIGINT) end the
+# suite with its folder removed and no case left running
+"$sph" bench --quick | head -n 1 >/dev/null
+ls "$TMPDIR"/sph_bench_* >/dev/null 2>&1 && bad "folder left after SIGPIPE" || ok
+timeout -s INT 5 "$sph" bench --quick >/dev/null 2>&1
+sleep 1
+ls "$TMPDIR"/sph_bench_* >/dev/null 2>&1 && bad "folder left after SIGINT" || ok
+pgrep -f "$sph bench --quick" >/dev/null &&
+  bad "a case still running after SIGINT" || ok
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]
