@@ -22,7 +22,7 @@ EXPECTED = {"pressure": 1, "velocity": 3, "displacement": 3,
 
 def watch(reader):
     """The list that the errors and warnings VTK reports while `reader`
-    runs are appended to (tests/mpi/check_mpi.py uses it too)."""
+    runs are appended to."""
     from vtkmodules.vtkCommonCore import vtkCommand
     problems = []
     for event in (vtkCommand.ErrorEvent, vtkCommand.WarningEvent):
@@ -30,6 +30,18 @@ def watch(reader):
         reader.GetExecutive().AddObserver(event,
                                           lambda obj, ev: problems.append(ev))
     return problems
+
+
+def read_polydata(path):
+    """A .vtp or a .pvtp (its pieces) read whole: the output and the errors
+    and warnings VTK reported (tests/mpi/check_mpi.py, check_killed.py)."""
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPPolyDataReader
+    reader = (vtkXMLPPolyDataReader() if path.endswith(".pvtp")
+              else vtkXMLPolyDataReader())
+    problems = watch(reader)
+    reader.SetFileName(path)
+    reader.Update()
+    return reader.GetOutput(), problems
 
 
 def read_one(path):

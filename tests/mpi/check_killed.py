@@ -19,7 +19,7 @@ import zlib
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "io"))
-from check_vtk import watch  # noqa: E402
+from check_vtk import read_polydata  # noqa: E402
 
 problems = []
 
@@ -29,15 +29,10 @@ def fail(msg):
 
 
 def points(path):
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPPolyDataReader
-    reader = (vtkXMLPPolyDataReader() if path.endswith(".pvtp")
-              else vtkXMLPolyDataReader())
-    seen = watch(reader)
-    reader.SetFileName(path)
-    reader.Update()
+    poly, seen = read_polydata(path)
     if seen:
         fail("VTK reported %s reading %s" % (seen, path))
-    return reader.GetOutput().GetNumberOfPoints()
+    return poly.GetNumberOfPoints()
 
 
 def manifest(path, d):

@@ -22,7 +22,7 @@ import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 "..", "io"))
-from check_vtk import watch  # noqa: E402
+from check_vtk import read_polydata  # noqa: E402
 
 
 def fail(msg):
@@ -30,15 +30,9 @@ def fail(msg):
 
 
 def read(path):
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPPolyDataReader
-    reader = (vtkXMLPPolyDataReader() if path.endswith(".pvtp")
-              else vtkXMLPolyDataReader())
-    problems = watch(reader)
-    reader.SetFileName(path)
-    reader.Update()
+    poly, problems = read_polydata(path)
     if problems:
         fail("VTK reported %s reading %s" % (problems, path))
-    poly = reader.GetOutput()
 
     def values(a):  # no numpy in Debian's python3-vtk9 dependencies
         nc = a.GetNumberOfComponents()
