@@ -188,6 +188,103 @@ void sph_domain_rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
 
 #ifdef SPH_HAVE_MPI
 
+/* ---- the same partition by counting bisection ------------------------- */
+
+/* a coordinate as an unsigned key of the same order (-0 as +0) */
+static uint64_t ordered_bits(double x) {
+  uint64_t u;
+  x = x == 0.0 ? 0.0 : x;
+  memcpy(&u, &x, sizeof u);
+  return u >> 63 ? ~u : u | 1ull << 63;
+}
+
+/* particles (of idx, m local) at or below the key (v, w) over all ranks */
+static int64_t count_below(const uint64_t *u, const int64_t *t,
+                           const size_t *idx, size_t m, uint64_t v, int64_t w,
+                           int ties) {
+  int64_t c = 0, all = 0;
+  for (size_t j = 0; j < m; ++j)
+    c += ties ? u[idx[j]] < v || (u[idx[j]] == v && t[idx[j]] <= w)
+              : u[idx[j]] <= v;
+  MPI_Allreduce(&c, &all, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+  return all;
+}
+
+/* sph_domain_rcb's recursion over the local particles idx of ranks rank0
+ * .. rank0 + nranks - 1: the box and count from reductions, the cut-th
+ * key (coordinate, tie key) by bisection of its bits */
+static void rcb_counted(const double *X, const int64_t *t, uint64_t *u,
+                        size_t *idx, size_t m, int dim, int rank0, int nranks,
+                        int *owner) {
+  if (nranks == 1) {
+    for (size_t j = 0; j < m; ++j)
+      owner[idx[j]] = rank0;
+    return;
+  }
+  double b[6] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+  for (size_t j = 0; j < m; ++j)
+    for (int c = 0; c < dim; ++c) {
+      b[c] = fmin(b[c], X[3 * idx[j] + c]);
+      b[3 + c] = fmin(b[3 + c], -X[3 * idx[j] + c]);
+    }
+  double box[6];
+  MPI_Allreduce(b, box, 6, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  double hi[3] = {-box[3], -box[4], -box[5]};
+  int ax = axis_of(box, hi, dim);
+  int64_t mine = (int64_t)m, n = 0;
+  MPI_Allreduce(&mine, &n, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+  int nlo = nranks / 2;
+  int64_t cut = n * nlo / nranks;
+  for (size_t j = 0; j < m; ++j)
+    u[idx[j]] = ordered_bits(X[3 * idx[j] + ax]);
+  /* the smallest coordinate key with cut particles at or below it, then
+   * the smallest tie key among its particles that completes the cut */
+  uint64_t lo = 0, top = UINT64_MAX;
+  while (cut > 0 && lo < top) {
+    uint64_t mid = lo + (top - lo) / 2;
+    if (count_below(u, t, idx, m, mid, 0, 0) >= cut)
+      top = mid;
+    else
+      lo = mid + 1;
+  }
+  int64_t wlo = INT64_MIN, wtop = INT64_MAX;
+  while (cut > 0 && wlo < wtop) {
+    int64_t mid = wlo + (int64_t)(((uint64_t)wtop - (uint64_t)wlo) / 2);
+    if (count_below(u, t, idx, m, lo, mid, 1) >= cut)
+      wtop = mid;
+    else
+      wlo = mid + 1;
+  }
+  /* the low ranks' particles first in idx */
+  size_t nb = 0;
+  for (size_t j = 0; j < m; ++j) {
+    size_t i = idx[j];
+    if (cut > 0 && (u[i] < lo || (u[i] == lo && t[i] <= wlo))) {
+      idx[j] = idx[nb];
+      idx[nb++] = i;
+    }
+  }
+  rcb_counted(X, t, u, idx, nb, dim, rank0, nlo, owner);
+  rcb_counted(X, t, u, idx + nb, m - nb, dim, rank0 + nlo, nranks - nlo, owner);
+}
+
+void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
+                            int dim, int *owner) {
+  uint64_t *u = malloc((n ? n : 1) * sizeof *u);
+  size_t *idx = malloc((n ? n : 1) * sizeof *idx);
+  for (size_t i = 0; idx && i < n; ++i)
+    idx[i] = i;
+  int ok = u && idx, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (all)
+    rcb_counted(X, t, u, idx, n, dim, 0, world_size, owner);
+  else
+    for (size_t i = 0; i < n; ++i)
+      owner[i] = -1;
+  free(u);
+  free(idx);
+}
+
 /* the ghosts of rank r: particles of the same body within `support` of an
  * owned one, from a cell-list search over the owned particles and those in
  * their box widened by `support`; flags ghost[i] = 1 in the whole set */

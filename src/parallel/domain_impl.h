@@ -46,6 +46,14 @@ typedef struct rcb_key {
 void sph_domain_rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
                     int nranks, int *owner, int *axis, double *cutv);
 
+/* The partition of sph_domain_rcb computed without any rank holding the
+ * whole set (collective): each rank passes its n particles' positions X (3
+ * per particle) and tie keys t (unique over all ranks; the storage index
+ * makes it sph_domain_rcb's partition); owner[i] is the rank that owns
+ * particle i. Each cut is found by counting bisection (MPI_Allreduce). */
+void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
+                            int dim, int *owner);
+
 /* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
  * over R ranks; the dynamic state from the first partition (owner of every
  * particle of the whole set, the cut tree); its destruction */

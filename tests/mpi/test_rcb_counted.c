@@ -1,0 +1,127 @@
+/* The partition by counting bisection (sph_domain_rcb_counted, issue 20)
+ * against sph_domain_rcb of the whole set: each rank holds a share of the
+ * particles picked by index (uneven, interleaved), and every particle gets
+ * the owner the whole set's RCB gives it. Lattices with many equal
+ * coordinates (ties by index), signed zeros, a 2D set, random points.
+ * Run under mpirun (ctest: 2, 3 and 4 ranks). */
+#include "parallel/domain_impl.h"
+
+#include <check.h>
+#include <math.h>
+#include <mpi.h>
+#include <stdlib.h>
+
+/* particles of the whole set whose owners disagree, over all ranks */
+static long mismatches(const double *X, size_t N, int dim) {
+  int rank = sph_domain_world_rank(), R = sph_domain_world_size();
+  rcb_key *k = malloc(N * sizeof *k);
+  int *whole = malloc(N * sizeof *whole);
+  double *x = malloc(3 * N * sizeof *x);
+  int64_t *t = malloc(N * sizeof *t);
+  int *owner = malloc(N * sizeof *owner);
+  ck_assert(k && whole && x && t && owner);
+  for (size_t i = 0; i < N; ++i)
+    k[i] = (rcb_key){0.0, (int64_t)i};
+  sph_domain_rcb(X, dim, k, N, 0, R, whole, NULL, NULL);
+  /* this rank's share: uneven, not in index order */
+  size_t m = 0;
+  for (size_t j = 0; j < N; ++j) {
+    size_t i = N - 1 - j;
+    if ((i * 7 + i / 5) % (size_t)(R + 1) % (size_t)R == (size_t)rank) {
+      for (int c = 0; c < 3; ++c)
+        x[3 * m + c] = X[3 * i + c];
+      t[m++] = (int64_t)i;
+    }
+  }
+  sph_domain_rcb_counted(x, t, m, dim, owner);
+  long bad = 0, all = 0;
+  for (size_t j = 0; j < m; ++j)
+    bad += owner[j] != whole[t[j]];
+  MPI_Allreduce(&bad, &all, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  free(k);
+  free(whole);
+  free(x);
+  free(t);
+  free(owner);
+  return all;
+}
+
+/* an nx x ny x nz lattice of spacing h from `at`, in a scrambled order */
+static double *lattice(int nx, int ny, int nz, double h, const double at[3],
+                       size_t *n) {
+  *n = (size_t)nx * (size_t)ny * (size_t)nz;
+  double *X = calloc(3 * *n, sizeof *X);
+  ck_assert(X);
+  for (size_t p = 0; p < *n; ++p) {
+    size_t q =
+        (p * 7919) % *n; /* 7919 prime: a permutation unless it divides */
+    size_t i = q % (size_t)nx, j = q / (size_t)nx % (size_t)ny,
+           l = q / ((size_t)nx * (size_t)ny);
+    X[3 * p] = at[0] + h * (double)i;
+    X[3 * p + 1] = at[1] + h * (double)j;
+    X[3 * p + 2] = nz > 1 ? at[2] + h * (double)l : 0.0;
+  }
+  return X;
+}
+
+START_TEST(test_column_lattice) {
+  size_t n;
+  double *X = lattice(7, 37, 7, 1.0 / 6.0, (double[]){-0.5, 0.0, -0.5}, &n);
+  ck_assert_int_eq(mismatches(X, n, 3), 0);
+  free(X);
+}
+END_TEST
+
+START_TEST(test_signed_zeros_and_cube) {
+  size_t n;
+  double *X = lattice(9, 9, 9, 0.25, (double[]){-1.0, -1.0, -1.0}, &n);
+  for (size_t i = 0; i < 3 * n; i += 2) /* -0 and +0 are the same place */
+    if (X[i] == 0.0)
+      X[i] = -0.0;
+  ck_assert_int_eq(mismatches(X, n, 3), 0);
+  free(X);
+}
+END_TEST
+
+START_TEST(test_plane) {
+  size_t n;
+  double *X = lattice(41, 13, 1, 0.01, (double[]){-0.2, 0.0, 0.0}, &n);
+  ck_assert_int_eq(mismatches(X, n, 2), 0);
+  free(X);
+}
+END_TEST
+
+START_TEST(test_random_points) {
+  size_t n = 5000;
+  double *X = malloc(3 * n * sizeof *X);
+  ck_assert(X);
+  unsigned long s = 12345;
+  for (size_t i = 0; i < 3 * n; ++i) {
+    s = s * 6364136223846793005ul + 1442695040888963407ul;
+    X[i] = (double)(s >> 11) / 9007199254740992.0 * (i % 3 == 1 ? 4.0 : 1.0);
+  }
+  ck_assert_int_eq(mismatches(X, n, 3), 0);
+  ck_assert_int_eq(mismatches(X, 3, 3), 0); /* fewer particles than ranks */
+  free(X);
+}
+END_TEST
+
+int main(int argc, char **argv) {
+  sph_error err;
+  if (sph_domain_init(&argc, &argv, &err) != SPH_OK)
+    return EXIT_FAILURE;
+  Suite *s = suite_create("rcb_counted");
+  TCase *tc = tcase_create("rcb_counted");
+  tcase_add_test(tc, test_column_lattice);
+  tcase_add_test(tc, test_signed_zeros_and_cube);
+  tcase_add_test(tc, test_plane);
+  tcase_add_test(tc, test_random_points);
+  suite_add_tcase(s, tc);
+  SRunner *sr = srunner_create(s);
+  srunner_set_fork_status(sr, CK_NOFORK); /* one MPI process a rank */
+  srunner_run_all(sr, sph_domain_world_rank() == 0 ? CK_NORMAL : CK_SILENT);
+  int failed = srunner_ntests_failed(sr);
+  srunner_free(sr);
+  sph_domain_finalize();
+  return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
