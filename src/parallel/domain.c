@@ -7,6 +7,7 @@
 #include "sph/domain.h"
 #include "parallel/domain_impl.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -943,4 +944,49 @@ void sph_domain_sort_lists_by(sph_neighbors *nl, size_t n, const int64_t *key) {
       v[j] = x;
     }
   }
+}
+
+/* (with or without MPI: one rank copies its values) */
+sph_status sph_domain_allgather_i64(sph_domain *d, const int64_t *v,
+                                    size_t count, int64_t **out, size_t *total,
+                                    sph_error *err) {
+  *out = NULL;
+  *total = 0;
+  int R = d ? d->size : 1, mine = (int)count;
+  int *cnt = malloc((size_t)R * sizeof *cnt);
+  int *off = malloc(((size_t)R + 1) * sizeof *off);
+  int64_t *all = NULL;
+  sph_status st =
+      cnt && off && count <= (size_t)INT_MAX
+          ? SPH_OK
+          : sph_error_set(err, SPH_ERR_NOMEM, "gather of %zu", count);
+  if ((st = sph_domain_agree(d, st, err)) != SPH_OK)
+    goto done;
+  cnt[0] = mine;
+#ifdef SPH_HAVE_MPI
+  if (d)
+    MPI_Allgather(&mine, 1, MPI_INT, cnt, 1, MPI_INT, MPI_COMM_WORLD);
+#endif
+  off[0] = 0;
+  for (int q = 0; q < R; ++q)
+    off[q + 1] = off[q] + cnt[q];
+  all = malloc(((size_t)off[R] + 1) * sizeof *all);
+  st = all ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "gather of %d", off[R]);
+  if ((st = sph_domain_agree(d, st, err)) != SPH_OK)
+    goto done;
+  if (!d)
+    memcpy(all, v, count * sizeof *v);
+#ifdef SPH_HAVE_MPI
+  if (d)
+    MPI_Allgatherv(v, mine, MPI_INT64_T, all, cnt, off, MPI_INT64_T,
+                   MPI_COMM_WORLD);
+#endif
+  *out = all;
+  *total = (size_t)off[R];
+  all = NULL;
+done:
+  free(all);
+  free(cnt);
+  free(off);
+  return st;
 }

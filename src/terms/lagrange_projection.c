@@ -470,48 +470,55 @@ static size_t lp_owned(const int64_t *gidx, size_t n, int64_t g) {
   return lo < n && gidx[lo] == g ? lo : n;
 }
 
-/* Boundary points over MPI ranks: the owners' selections, densities and
- * rows (storage indices of the row's particles) are added over the ranks,
- * each slot written by one rank only, so every rank holds them in storage
- * order; a rank keeps the entries of its owned particles. */
+/* (storage index, selection bits) pairs by storage index */
+static int cmp_point(const void *pa, const void *pb) {
+  const int64_t *a = pa, *b = pb;
+  return (a[0] > b[0]) - (a[0] < b[0]);
+}
+
+/* Boundary points over MPI ranks: each rank's selected points (storage
+ * index, selection bits) gathered on every rank and put in storage order;
+ * their densities and rows (storage indices of the row's particles) are
+ * added over the ranks, each slot written by one rank only; a rank keeps
+ * the entries of its owned particles. */
+
 static sph_status lp_points_distributed(lagrange_projection *lp,
                                         const sph_neighbors *nl, sph_sim *sim,
                                         const double *rho0, sph_error *err) {
   sph_domain *d = lp->dom;
   const int64_t *gidx = sph_domain_storage_index(d);
-  size_t n = lp->n, nb = 0, len = 0;
-  double total = (double)n;
-  sph_domain_sum(d, &total, 1);
-  size_t N = (size_t)total;
-  double *sel = calloc(N + 1, sizeof *sel), *buf = NULL;
-  int64_t *bg = NULL;
-  sph_status st = SPH_OK;
-  if (!sel) {
-    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
-    goto done;
-  }
+  size_t n = lp->n, nb = 0, len = 0, mine = 0;
   for (size_t a = 0; a < n; ++a)
-    sel[gidx[a]] = (double)lp_member(lp, sim, a);
-  sph_domain_sum_long(d, sel, N, lp->work, LP_CHUNK);
-  for (size_t g = 0; g < N; ++g)
-    nb += sel[g] != 0.0;
-  if (nb > LP_MAX_POINTS) {
-    st = lp_too_many(nb, err);
-    goto done;
+    mine += lp_member(lp, sim, a) != 0;
+  double total = (double)mine;
+  sph_domain_sum(d, &total, 1);
+  if (total > LP_MAX_POINTS)
+    return lp_too_many((size_t)total, err);
+  int64_t *own = malloc((2 * mine + 1) * sizeof *own), *sel = NULL;
+  double *buf = NULL;
+  sph_status st =
+      own ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+  for (size_t a = 0, k = 0; own && a < n; ++a) {
+    uint32_t m = lp_member(lp, sim, a);
+    if (m) {
+      own[2 * k] = gidx[a];
+      own[2 * k++ + 1] = (int64_t)m;
+    }
   }
-  /* per point: storage index, row length and density */
-  bg = malloc((nb + 1) * sizeof *bg);
+  st = sph_domain_agree(d, st, err);
+  if (st == SPH_OK)
+    st = sph_domain_allgather_i64(d, own, 2 * mine, &sel, &nb, err);
+  if (st != SPH_OK)
+    goto done;
+  nb /= 2;
+  qsort(sel, nb, 2 * sizeof *sel, cmp_point);
+  /* per point: row length and density */
   buf = calloc(2 * nb + 1, sizeof *buf);
-  if (!bg || !buf) {
-    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+  st = buf ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+  if ((st = sph_domain_agree(d, st, err)) != SPH_OK)
     goto done;
-  }
-  nb = 0;
-  for (size_t g = 0; g < N; ++g)
-    if (sel[g] != 0.0)
-      bg[nb++] = (int64_t)g;
   for (size_t B = 0; B < nb; ++B) {
-    size_t P = lp_owned(gidx, n, bg[B]);
+    size_t P = lp_owned(gidx, n, sel[2 * B]);
     if (P < n) {
       buf[B] = (double)(1 + nl->offset[P + 1] - nl->offset[P]);
       buf[nb + B] = rho0[P];
@@ -520,22 +527,23 @@ static sph_status lp_points_distributed(lagrange_projection *lp,
   sph_domain_sum_long(d, buf, 2 * nb, lp->work, LP_CHUNK);
   for (size_t B = 0; B < nb; ++B)
     len += (size_t)buf[B];
-  if ((st = lp_alloc_rows(lp, nb, len, err)) != SPH_OK)
+  st = lp_alloc_rows(lp, nb, len, err);
+  if ((st = sph_domain_agree(d, st, err)) != SPH_OK)
     goto done;
   lp->nb = nb;
   for (size_t B = 0; B < nb; ++B) {
-    lp->member[B] = (uint32_t)sel[bg[B]];
+    lp->member[B] = (uint32_t)sel[2 * B + 1];
     lp->rho0[B] = buf[nb + B];
     lp->roff[B + 1] = lp->roff[B] + (size_t)buf[B];
   }
   /* the rows: storage index then W~_a(X_B) of each entry */
   free(buf);
-  if (!(buf = calloc(2 * len + 1, sizeof *buf))) {
-    st = sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+  buf = calloc(2 * len + 1, sizeof *buf);
+  st = buf ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "lagrange projection");
+  if ((st = sph_domain_agree(d, st, err)) != SPH_OK)
     goto done;
-  }
   for (size_t B = 0; B < nb; ++B) {
-    size_t P = lp_owned(gidx, n, bg[B]), r = lp->roff[B];
+    size_t P = lp_owned(gidx, n, sel[2 * B]), r = lp->roff[B];
     if (P == n)
       continue;
     buf[2 * r] = (double)gidx[P];
@@ -561,9 +569,9 @@ static sph_status lp_points_distributed(lagrange_projection *lp,
   }
   lp->roff[nb] = r;
 done:
+  free(own);
   free(sel);
   free(buf);
-  free(bg);
   return st;
 }
 
