@@ -198,9 +198,17 @@ static uint64_t ordered_bits(double x) {
   return u >> 63 ? ~u : u | 1ull << 63;
 }
 
+/* the coordinate of an ordered_bits key (-0 comes back as +0) */
+static double ordered_value(uint64_t u) {
+  double x;
+  u = u >> 63 ? u & ~(1ull << 63) : ~u;
+  memcpy(&x, &u, sizeof x);
+  return x;
+}
+
 /* particles (of idx, m local) at or below the key (v, w) over all ranks */
 static int64_t count_below(const uint64_t *u, const int64_t *t,
-                           const size_t *idx, size_t m, uint64_t v, int64_t w,
+                           const uint64_t *idx, size_t m, uint64_t v, int64_t w,
                            int ties) {
   int64_t c = 0, all = 0;
   for (size_t j = 0; j < m; ++j)
@@ -212,10 +220,11 @@ static int64_t count_below(const uint64_t *u, const int64_t *t,
 
 /* sph_domain_rcb's recursion over the local particles idx of ranks rank0
  * .. rank0 + nranks - 1: the box and count from reductions, the cut-th
- * key (coordinate, tie key) by bisection of its bits */
+ * key (coordinate, tie key) by bisection of its bits; the cut plane as
+ * sph_domain_rcb records it when axis is not NULL */
 static void rcb_counted(const double *X, const int64_t *t, uint64_t *u,
-                        size_t *idx, size_t m, int dim, int rank0, int nranks,
-                        int *owner) {
+                        uint64_t *idx, size_t m, int dim, int rank0, int nranks,
+                        int *owner, int *axis, double *cutv) {
   if (nranks == 1) {
     for (size_t j = 0; j < m; ++j)
       owner[idx[j]] = rank0;
@@ -237,17 +246,20 @@ static void rcb_counted(const double *X, const int64_t *t, uint64_t *u,
   int64_t cut = n * nlo / nranks;
   for (size_t j = 0; j < m; ++j)
     u[idx[j]] = ordered_bits(X[3 * idx[j] + ax]);
-  /* the smallest coordinate key with cut particles at or below it, then
-   * the smallest tie key among its particles that completes the cut */
+  /* the smallest coordinate key with cut particles at or below it (ctop
+   * of them), then the smallest tie key among its particles that
+   * completes the cut (every one of them when ctop is exactly cut) */
   uint64_t lo = 0, top = UINT64_MAX;
+  int64_t ctop = n;
   while (cut > 0 && lo < top) {
     uint64_t mid = lo + (top - lo) / 2;
-    if (count_below(u, t, idx, m, mid, 0, 0) >= cut)
-      top = mid;
+    int64_t c = count_below(u, t, idx, m, mid, 0, 0);
+    if (c >= cut)
+      top = mid, ctop = c;
     else
       lo = mid + 1;
   }
-  int64_t wlo = INT64_MIN, wtop = INT64_MAX;
+  int64_t wlo = ctop == cut ? INT64_MAX : INT64_MIN, wtop = INT64_MAX;
   while (cut > 0 && wlo < wtop) {
     int64_t mid = wlo + (int64_t)(((uint64_t)wtop - (uint64_t)wlo) / 2);
     if (count_below(u, t, idx, m, lo, mid, 1) >= cut)
@@ -257,32 +269,47 @@ static void rcb_counted(const double *X, const int64_t *t, uint64_t *u,
   }
   /* the low ranks' particles first in idx */
   size_t nb = 0;
+  uint64_t first = UINT64_MAX; /* the high side's smallest key */
   for (size_t j = 0; j < m; ++j) {
-    size_t i = idx[j];
+    uint64_t i = idx[j];
     if (cut > 0 && (u[i] < lo || (u[i] == lo && t[i] <= wlo))) {
       idx[j] = idx[nb];
       idx[nb++] = i;
+    } else if (u[i] < first) {
+      first = u[i];
     }
   }
-  rcb_counted(X, t, u, idx, nb, dim, rank0, nlo, owner);
-  rcb_counted(X, t, u, idx + nb, m - nb, dim, rank0 + nlo, nranks - nlo, owner);
+  if (axis) { /* halfway between the two sides' nearest particles */
+    uint64_t f = first;
+    MPI_Allreduce(&f, &first, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+    axis[rank0 + nlo] = ax;
+    cutv[rank0 + nlo] = n == 0     ? 0.0
+                        : cut == 0 ? ordered_value(first)
+                        : cut == n
+                            ? ordered_value(lo)
+                            : 0.5 * (ordered_value(lo) + ordered_value(first));
+  }
+  rcb_counted(X, t, u, idx, nb, dim, rank0, nlo, owner, axis, cutv);
+  rcb_counted(X, t, u, idx + nb, m - nb, dim, rank0 + nlo, nranks - nlo, owner,
+              axis, cutv);
 }
 
 void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
-                            int dim, int *owner) {
-  uint64_t *u = malloc((n ? n : 1) * sizeof *u);
-  size_t *idx = malloc((n ? n : 1) * sizeof *idx);
+                            int dim, int *owner, int *axis, double *cut,
+                            uint64_t *work) {
+  uint64_t *u = work ? work : malloc(2 * (n ? n : 1) * sizeof *u);
+  uint64_t *idx = u ? u + n : NULL;
   for (size_t i = 0; idx && i < n; ++i)
     idx[i] = i;
-  int ok = u && idx, all = 0;
+  int ok = u != NULL, all = 0;
   MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (all)
-    rcb_counted(X, t, u, idx, n, dim, 0, world_size, owner);
+    rcb_counted(X, t, u, idx, n, dim, 0, world_size, owner, axis, cut);
   else
     for (size_t i = 0; i < n; ++i)
       owner[i] = -1;
-  free(u);
-  free(idx);
+  if (!work)
+    free(u);
 }
 
 /* the ghosts of rank r: particles of the same body within `support` of an
