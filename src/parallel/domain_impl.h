@@ -61,8 +61,9 @@ void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
                             uint64_t *work);
 
 /* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
- * over R ranks; the dynamic state from the first partition (owner of every
- * particle of the whole set, the cut tree); its destruction */
+ * over R ranks; the dynamic state from the first partition (the particle
+ * count and the cut tree, axis and cut R + 1 each: nothing N-sized is
+ * kept); its destruction */
 size_t sph_domain_dyn_capacity(size_t N, int R);
 sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
                                  const double *cut, sph_error *err);
