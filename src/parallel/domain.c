@@ -199,24 +199,62 @@ static uint64_t ordered_bits(double x) {
   return u >> 63 ? ~u : u | 1ull << 63;
 }
 
-/* particles (of idx, m local) at or below the key (v, w) over all ranks */
-static int64_t count_below(const uint64_t *u, const int64_t *t,
-                           const size_t *idx, size_t m, uint64_t v, int64_t w,
-                           int ties) {
-  int64_t c = 0, all = 0;
-  for (size_t j = 0; j < m; ++j)
-    c += ties ? u[idx[j]] < v || (u[idx[j]] == v && t[idx[j]] <= w)
-              : u[idx[j]] <= v;
-  MPI_Allreduce(&c, &all, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
-  return all;
+/* the coordinate of an ordered_bits key (-0 comes back as +0) */
+static double ordered_value(uint64_t u) {
+  double x;
+  u = u >> 63 ? u & ~(1ull << 63) : ~u;
+  memcpy(&x, &u, sizeof x);
+  return x;
 }
 
-/* sph_domain_rcb's recursion over the local particles idx of ranks rank0
- * .. rank0 + nranks - 1: the box and count from reductions, the cut-th
- * key (coordinate, tie key) by bisection of its bits */
-static void rcb_counted(const double *X, const int64_t *t, uint64_t *u,
-                        size_t *idx, size_t m, int dim, int rank0, int nranks,
-                        int *owner) {
+#define RADIX 256 /* buckets a round of the selection: 8 bits */
+
+/* the k-th smallest (from 1) over all ranks of the keys u[idx[j]] (or,
+ * with t, of the tie keys of the particles whose key is *kth, as
+ * unsigned keys of the same order), all within range[0] .. range[1], by 8
+ * bits a round: a histogram of the next byte of the keys that share the
+ * bytes found so far (the range's common leading bytes to begin with),
+ * summed with MPI_Allreduce; *below: the keys smaller than the one found,
+ * *at: the keys equal to it */
+static uint64_t radix_select(const uint64_t *u, const int64_t *t,
+                             const uint64_t *idx, size_t m, int64_t k,
+                             const uint64_t *kth, const uint64_t range[2],
+                             int64_t *below, int64_t *at) {
+  int64_t h[RADIX], sum[RADIX];
+  int r0 = 0;
+  while (r0 < 7 && (range[0] ^ range[1]) >> (56 - 8 * r0) == 0)
+    ++r0;
+  uint64_t prefix = r0 ? range[0] >> (64 - 8 * r0) : 0;
+  *below = 0;
+  for (int r = r0; r < 8; ++r) {
+    int shift = 56 - 8 * r;
+    memset(h, 0, sizeof h);
+    for (size_t j = 0; j < m; ++j) {
+      uint64_t i = idx[j];
+      if (t && u[i] != *kth)
+        continue;
+      uint64_t v = t ? (uint64_t)t[i] ^ 1ull << 63 : u[i];
+      if (r == r0 || v >> (shift + 8) == prefix)
+        h[v >> shift & (RADIX - 1)] += 1;
+    }
+    MPI_Allreduce(h, sum, RADIX, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+    int q = 0;
+    while (q < RADIX - 1 && *below + sum[q] < k)
+      *below += sum[q++];
+    prefix = prefix << 8 | (uint64_t)q;
+    *at = sum[q];
+  }
+  return prefix;
+}
+
+/* sph_domain_rcb's recursion over the local particles idx (n over all
+ * ranks) of ranks rank0 .. rank0 + nranks - 1: the box from a reduction,
+ * the cut-th key (coordinate, tie key) by radix selection; the cut plane
+ * as sph_domain_rcb records it when axis is not NULL */
+static void rcb_counted(const double *X, const int64_t *t,
+                        const uint64_t trange[2], uint64_t *u, uint64_t *idx,
+                        size_t m, int64_t n, int dim, int rank0, int nranks,
+                        int *owner, int *axis, double *cutv) {
   if (nranks == 1) {
     for (size_t j = 0; j < m; ++j)
       owner[idx[j]] = rank0;
@@ -232,58 +270,74 @@ static void rcb_counted(const double *X, const int64_t *t, uint64_t *u,
   MPI_Allreduce(b, box, 6, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
   double hi[3] = {-box[3], -box[4], -box[5]};
   int ax = axis_of(box, hi, dim);
-  int64_t mine = (int64_t)m, n = 0;
-  MPI_Allreduce(&mine, &n, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
   int nlo = nranks / 2;
   int64_t cut = n * nlo / nranks;
   for (size_t j = 0; j < m; ++j)
     u[idx[j]] = ordered_bits(X[3 * idx[j] + ax]);
-  /* the smallest coordinate key with cut particles at or below it, then
-   * the smallest tie key among its particles that completes the cut */
-  uint64_t lo = 0, top = UINT64_MAX;
-  while (cut > 0 && lo < top) {
-    uint64_t mid = lo + (top - lo) / 2;
-    if (count_below(u, t, idx, m, mid, 0, 0) >= cut)
-      top = mid;
-    else
-      lo = mid + 1;
-  }
-  int64_t wlo = INT64_MIN, wtop = INT64_MAX;
-  while (cut > 0 && wlo < wtop) {
-    int64_t mid = wlo + (int64_t)(((uint64_t)wtop - (uint64_t)wlo) / 2);
-    if (count_below(u, t, idx, m, lo, mid, 1) >= cut)
-      wtop = mid;
-    else
-      wlo = mid + 1;
-  }
+  /* the cut-th coordinate key, then the tie key among its particles that
+   * completes the cut (all of them when they end exactly at the cut) */
+  uint64_t lo = 0, range[2] = {ordered_bits(box[ax]), ordered_bits(hi[ax])};
+  int64_t wlo = INT64_MAX, below = 0, at = 0, tb, ta;
+  if (cut > 0)
+    lo = radix_select(u, NULL, idx, m, cut, NULL, range, &below, &at);
+  if (cut > 0 && below + at > cut)
+    wlo = (int64_t)(radix_select(u, t, idx, m, cut - below, &lo, trange, &tb,
+                                 &ta) ^
+                    1ull << 63);
   /* the low ranks' particles first in idx */
   size_t nb = 0;
+  uint64_t first = UINT64_MAX; /* the high side's smallest key */
   for (size_t j = 0; j < m; ++j) {
-    size_t i = idx[j];
+    uint64_t i = idx[j];
     if (cut > 0 && (u[i] < lo || (u[i] == lo && t[i] <= wlo))) {
       idx[j] = idx[nb];
       idx[nb++] = i;
+    } else if (u[i] < first) {
+      first = u[i];
     }
   }
-  rcb_counted(X, t, u, idx, nb, dim, rank0, nlo, owner);
-  rcb_counted(X, t, u, idx + nb, m - nb, dim, rank0 + nlo, nranks - nlo, owner);
+  if (axis) { /* halfway between the two sides' nearest particles */
+    uint64_t f = first;
+    MPI_Allreduce(&f, &first, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+    axis[rank0 + nlo] = ax;
+    cutv[rank0 + nlo] = n == 0     ? 0.0
+                        : cut == 0 ? ordered_value(first)
+                        : cut == n
+                            ? ordered_value(lo)
+                            : 0.5 * (ordered_value(lo) + ordered_value(first));
+  }
+  rcb_counted(X, t, trange, u, idx, nb, cut, dim, rank0, nlo, owner, axis,
+              cutv);
+  rcb_counted(X, t, trange, u, idx + nb, m - nb, n - cut, dim, rank0 + nlo,
+              nranks - nlo, owner, axis, cutv);
 }
 
 void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
-                            int dim, int *owner) {
-  uint64_t *u = malloc((n ? n : 1) * sizeof *u);
-  size_t *idx = malloc((n ? n : 1) * sizeof *idx);
+                            int dim, int *owner, int *axis, double *cut,
+                            uint64_t *work) {
+  uint64_t *u = work ? work : malloc(2 * (n ? n : 1) * sizeof *u);
+  uint64_t *idx = u ? u + n : NULL;
   for (size_t i = 0; idx && i < n; ++i)
     idx[i] = i;
-  int ok = u && idx, all = 0;
-  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  if (all)
-    rcb_counted(X, t, u, idx, n, dim, 0, world_size, owner);
+  /* the particles and the range of the tie keys (as ordered unsigned) */
+  int64_t v[2] = {u == NULL, (int64_t)n}, all[2];
+  uint64_t tr[2] = {UINT64_MAX, UINT64_MAX}, trange[2];
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t k = (uint64_t)t[i] ^ 1ull << 63;
+    tr[0] = k < tr[0] ? k : tr[0];
+    tr[1] = ~k < tr[1] ? ~k : tr[1];
+  }
+  MPI_Allreduce(v, all, 2, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(tr, trange, 2, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+  trange[1] = ~trange[1];
+  if (!all[0])
+    rcb_counted(X, t, trange, u, idx, n, all[1], dim, 0, world_size, owner,
+                axis, cut);
   else
     for (size_t i = 0; i < n; ++i)
       owner[i] = -1;
-  free(u);
-  free(idx);
+  if (!work)
+    free(u);
 }
 
 /* the ghosts of rank r: particles of the same body within `support` of an

@@ -4,8 +4,9 @@
  * the particles that left their rank's region of the recursive coordinate
  * bisection (the cut planes of the last partition) to their owner with all
  * their per-particle values, re-balancing by a new RCB of the current
- * positions when the count imbalance exceeds SPH_DOMAIN_IMBALANCE, and a
- * halo exchange of several arrays in one message per neighbour rank; for
+ * positions when the count imbalance exceeds SPH_DOMAIN_IMBALANCE (by
+ * counting bisection over the owned particles: no rank holds them all),
+ * and a halo exchange of several arrays in one message per neighbour rank; for
  * checkpoints, a rank's owned particles packed with the cut tree and the
  * halo plan, put back in place on --resume. Every
  * buffer is sized at set-up (or at the first rebuild, in the method's
@@ -30,19 +31,15 @@ struct sph_domain_dyn {
   double *arr[DYN_MAX_ARRAYS]; /* the method's own per-particle arrays */
   int nc[DYN_MAX_ARRAYS];
   int narr;
-  int width;     /* doubles a packed particle; 0 before the first rebuild */
-  double *in;    /* packed particles received (cap) */
-  int *dest;     /* owner after the rebuild, per owned particle (cap) */
-  int *cs, *cr;  /* particles sent to, received from each rank */
-  int *os, *orr; /* their first packed particle */
-  int *at;       /* packing cursor per rank */
-  double *box;   /* 6 per rank: the owned particles' boxes, widened */
-  int *count;    /* owned per rank */
-  int *displ;    /* re-balance: their first value */
-  double *allx;  /* re-balance: 4 per particle, gathered (x, storage) */
-  double *X;     /* re-balance: 3 per particle by storage index */
-  rcb_key *keys; /* re-balance: N */
-  int *owner;    /* re-balance: N, by storage index */
+  int width;      /* doubles a packed particle; 0 before the first rebuild */
+  double *in;     /* packed particles received (cap) */
+  int *dest;      /* owner after the rebuild, per owned particle (cap) */
+  int *cs, *cr;   /* particles sent to, received from each rank */
+  int *os, *orr;  /* their first packed particle */
+  int *at;        /* packing cursor per rank */
+  double *box;    /* 6 per rank: the owned particles' boxes, widened */
+  int *count;     /* owned per rank */
+  uint64_t *work; /* re-balance: 2 keys per owned particle (cap) */
   double migrated, rebalances, rebuilds;
   double halo_max, ghosts_max; /* the largest halo and ghost layer */
   double *ckpt;                /* a checkpoint's domain state (ckpt_len) */
@@ -70,11 +67,7 @@ void sph_domain_dyn_destroy(sph_domain_dyn *y) {
   free(y->at);
   free(y->box);
   free(y->count);
-  free(y->displ);
-  free(y->allx);
-  free(y->X);
-  free(y->keys);
-  free(y->owner);
+  free(y->work);
   free(y->ckpt);
   free(y);
 }
@@ -132,17 +125,13 @@ sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
   y->at = calloc(R, sizeof *y->at);
   y->box = malloc(6 * R * sizeof *y->box);
   y->count = malloc(R * sizeof *y->count);
-  y->displ = malloc(R * sizeof *y->displ);
-  y->allx = malloc(4 * N * sizeof *y->allx);
-  y->X = malloc(3 * N * sizeof *y->X);
-  y->keys = malloc(N * sizeof *y->keys);
-  y->owner = malloc(N * sizeof *y->owner);
+  y->work = malloc(2 * cap * sizeof *y->work);
   y->ckpt = calloc(ckpt_len(R, cap), sizeof *y->ckpt);
   free(d->send_idx);
   d->send_idx = malloc(cap * sizeof *d->send_idx);
   if (!y->axis || !y->cut || !y->dest || !y->cs || !y->cr || !y->os ||
-      !y->orr || !y->at || !y->box || !y->count || !y->displ || !y->allx ||
-      !y->X || !y->keys || !y->owner || !y->ckpt || !d->send_idx)
+      !y->orr || !y->at || !y->box || !y->count || !y->work || !y->ckpt ||
+      !d->send_idx)
     return sph_error_set(err, SPH_ERR_NOMEM, "dynamic domain");
   memcpy(y->axis, axis, (R + 1) * sizeof *axis);
   memcpy(y->cut, cut, (R + 1) * sizeof *cut);
@@ -241,37 +230,13 @@ static int tree_owner(const sph_domain_dyn *y, const double *x, int nranks) {
   return rank0;
 }
 
-/* a new RCB of the current positions of every particle (gathered to every
- * rank, in storage order: the partition of the serial positions) */
+/* a new RCB of the current positions (ties by storage index: the
+ * partition of the serial positions) by counting bisection over the owned
+ * particles, and its cut tree */
 static void rebalance(sph_domain *d, sph_particles *ps) {
   sph_domain_dyn *y = d->dyn;
-  const double *x = ps->field[SPH_FIELD_POSITION];
-  size_t n = d->n;
-  double *mine = d->buf; /* 4 per owned particle */
-  for (size_t a = 0; a < n; ++a) {
-    memcpy(mine + 4 * a, x + 3 * a, 3 * sizeof *mine);
-    mine[4 * a + 3] = (double)d->gidx[a];
-  }
-  int at = 0;
-  for (int q = 0; q < d->size; ++q) {
-    y->displ[q] = at;
-    at += 4 * y->count[q];
-  }
-  int *cnt = y->at;
-  for (int q = 0; q < d->size; ++q)
-    cnt[q] = 4 * y->count[q];
-  MPI_Allgatherv(mine, 4 * (int)n, MPI_DOUBLE, y->allx, cnt, y->displ,
-                 MPI_DOUBLE, MPI_COMM_WORLD);
-  for (size_t k = 0; k < y->N; ++k) {
-    size_t g = (size_t)y->allx[4 * k + 3];
-    memcpy(y->X + 3 * g, y->allx + 4 * k, 3 * sizeof *y->X);
-  }
-  for (size_t i = 0; i < y->N; ++i)
-    y->keys[i] = (rcb_key){0.0, (int64_t)i};
-  sph_domain_rcb(y->X, d->dim, y->keys, y->N, 0, d->size, y->owner, y->axis,
-                 y->cut);
-  for (size_t a = 0; a < n; ++a)
-    y->dest[a] = y->owner[d->gidx[a]];
+  sph_domain_rcb_counted(ps->field[SPH_FIELD_POSITION], d->gidx, d->n, d->dim,
+                         y->dest, y->axis, y->cut, y->work);
   y->rebalances += 1.0;
 }
 

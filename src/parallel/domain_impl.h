@@ -50,13 +50,20 @@ void sph_domain_rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
  * whole set (collective): each rank passes its n particles' positions X (3
  * per particle) and tie keys t (unique over all ranks; the storage index
  * makes it sph_domain_rcb's partition); owner[i] is the rank that owns
- * particle i. Each cut is found by counting bisection (MPI_Allreduce). */
+ * particle i. Each cut is found by counting bisection (MPI_Allreduce).
+ * With axis and cut (R + 1 each; NULL on every rank or on none) the cut
+ * tree is sph_domain_rcb's too: ranks from s on lie at or above cut[s]
+ * along axis[s], s = 1 .. R - 1, the same values but for the sign of a
+ * zero. work: room for 2 n keys, or NULL to allocate it (owner -1 on
+ * every particle when that fails on some rank). */
 void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
-                            int dim, int *owner);
+                            int dim, int *owner, int *axis, double *cut,
+                            uint64_t *work);
 
 /* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
- * over R ranks; the dynamic state from the first partition (owner of every
- * particle of the whole set, the cut tree); its destruction */
+ * over R ranks; the dynamic state from the first partition (the particle
+ * count and the cut tree, axis and cut R + 1 each: nothing N-sized is
+ * kept); its destruction */
 size_t sph_domain_dyn_capacity(size_t N, int R);
 sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
                                  const double *cut, sph_error *err);

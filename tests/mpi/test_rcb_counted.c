@@ -1,8 +1,10 @@
 /* The partition by counting bisection (sph_domain_rcb_counted, issue 20)
  * against sph_domain_rcb of the whole set: each rank holds a share of the
  * particles picked by index (uneven, interleaved), and every particle gets
- * the owner the whole set's RCB gives it. Lattices with many equal
- * coordinates (ties by index), signed zeros, a 2D set, random points.
+ * the owner the whole set's RCB gives it, and the cut tree (axis, plane
+ * of every cut) is the whole set's on every rank, with the caller's work
+ * room or its own. Lattices with many equal coordinates (ties by index,
+ * cuts between equal coordinates), signed zeros, a 2D set, random points.
  * Run under mpirun (ctest: 2, 3 and 4 ranks). */
 #include "parallel/domain_impl.h"
 
@@ -11,18 +13,22 @@
 #include <mpi.h>
 #include <stdlib.h>
 
-/* particles of the whole set whose owners disagree, over all ranks */
-static long mismatches(const double *X, size_t N, int dim) {
+/* particles of the whole set whose owners disagree and cuts of the tree
+ * that differ, over all ranks (owners only with work, else the tree too) */
+static long mismatches_with(const double *X, size_t N, int dim, int work) {
   int rank = sph_domain_world_rank(), R = sph_domain_world_size();
   rcb_key *k = malloc(N * sizeof *k);
   int *whole = malloc(N * sizeof *whole);
   double *x = malloc(3 * N * sizeof *x);
   int64_t *t = malloc(N * sizeof *t);
   int *owner = malloc(N * sizeof *owner);
-  ck_assert(k && whole && x && t && owner);
+  uint64_t *room = malloc(2 * N * sizeof *room);
+  int axis[2][5] = {{-1, -1, -1, -1, -1}, {-1, -1, -1, -1, -1}};
+  double cut[2][5] = {{NAN, NAN, NAN, NAN, NAN}, {NAN, NAN, NAN, NAN, NAN}};
+  ck_assert(k && whole && x && t && owner && room && R <= 4);
   for (size_t i = 0; i < N; ++i)
     k[i] = (rcb_key){0.0, (int64_t)i};
-  sph_domain_rcb(X, dim, k, N, 0, R, whole, NULL, NULL);
+  sph_domain_rcb(X, dim, k, N, 0, R, whole, axis[0], cut[0]);
   /* this rank's share: uneven, not in index order */
   size_t m = 0;
   for (size_t j = 0; j < N; ++j) {
@@ -33,17 +39,51 @@ static long mismatches(const double *X, size_t N, int dim) {
       t[m++] = (int64_t)i;
     }
   }
-  sph_domain_rcb_counted(x, t, m, dim, owner);
+  if (work)
+    sph_domain_rcb_counted(x, t, m, dim, owner, NULL, NULL, room);
+  else
+    sph_domain_rcb_counted(x, t, m, dim, owner, axis[1], cut[1], NULL);
   long bad = 0, all = 0;
   for (size_t j = 0; j < m; ++j)
     bad += owner[j] != whole[t[j]];
+  /* the planes compare equal (-0 == +0); only cuts 1 .. R - 1 are made */
+  for (int s = 1; !work && s < R; ++s)
+    bad += axis[1][s] != axis[0][s] || !(cut[1][s] == cut[0][s]);
+  bad += !work && (axis[1][0] != -1 || axis[1][R] != -1);
   MPI_Allreduce(&bad, &all, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   free(k);
   free(whole);
   free(x);
   free(t);
   free(owner);
+  free(room);
   return all;
+}
+
+static long mismatches(const double *X, size_t N, int dim) {
+  return mismatches_with(X, N, dim, 0) + mismatches_with(X, N, dim, 1);
+}
+
+/* cuts whose plane lies on particles (equal coordinates on both sides of
+ * the cut: decided by the storage index), over the whole set's RCB */
+static int tied_cuts(const double *X, size_t N, int dim) {
+  int R = sph_domain_world_size(), axis[5], tied = 0;
+  double cut[5];
+  rcb_key *k = malloc(N * sizeof *k);
+  int *whole = malloc(N * sizeof *whole);
+  ck_assert(k && whole);
+  for (size_t i = 0; i < N; ++i)
+    k[i] = (rcb_key){0.0, (int64_t)i};
+  sph_domain_rcb(X, dim, k, N, 0, R, whole, axis, cut);
+  for (int s = 1; s < R; ++s)
+    for (size_t i = 0; i < N; ++i)
+      if (X[3 * i + axis[s]] == cut[s]) {
+        tied += 1;
+        break;
+      }
+  free(k);
+  free(whole);
+  return tied;
 }
 
 /* an nx x ny x nz lattice of spacing h from `at`, in a scrambled order */
@@ -67,6 +107,7 @@ static double *lattice(int nx, int ny, int nz, double h, const double at[3],
 START_TEST(test_column_lattice) {
   size_t n;
   double *X = lattice(7, 37, 7, 1.0 / 6.0, (double[]){-0.5, 0.0, -0.5}, &n);
+  ck_assert_int_gt(tied_cuts(X, n, 3), 0); /* the case the tree must hold */
   ck_assert_int_eq(mismatches(X, n, 3), 0);
   free(X);
 }
