@@ -31,9 +31,10 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
   /* a ghost's list is partial: its stabilised force matrix is its owner's */
   long nq = dom ? (long)ref->n_img : ne;
   int dim = m->sim->scene->dimension, stab = m->eta > 0.0;
+  /* an image's source may be a ghost: its state first */
+  SPH_TRY(sph_domain_exchange(dom, m->x, 3, err));
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  SPH_TRY(sph_domain_exchange(dom, m->x, 3, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
@@ -48,9 +49,9 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
       ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
   }
   if (stab) {
+    SPH_TRY(sph_domain_exchange(dom, m->f0, 9, err));
     if (ne > n)
       tl_mirror_refresh(ref, m->x, m->p, m->f0, NULL, NULL);
-    SPH_TRY(sph_domain_exchange(dom, m->f0, 9, err));
 #pragma omp parallel for schedule(static)
     for (long a = 0; a < n; ++a) {
       double acc[9] = {0}, f[9];
@@ -66,9 +67,9 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
       ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
     }
   }
+  SPH_TRY(sph_domain_exchange(dom, m->F, 9, err));
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  SPH_TRY(sph_domain_exchange(dom, m->F, 9, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];
@@ -222,7 +223,9 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
  * V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
 static sph_status rebuild(ul_csph *m, sph_error *err) {
   tl_reference *ref = &m->ref;
+  ul_mirror_sync(m);
   SPH_TRY(tl_reference_redistribute(ref, m->sim, err));
+  SPH_TRY(ul_mirror_place(m, err));
   m->lf.n = ref->n;
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
@@ -245,6 +248,7 @@ static sph_status reference_update(ul_csph *m, sph_error *err) {
   SPH_TRY(deformation_and_stress(m, (long)ref->n, err));
   memcpy(ref->X, m->x, 3 * ref->n_ext * sizeof *ref->X);
   memcpy(m->Fr, m->F, 9 * ref->n_ext * sizeof *m->Fr);
+  ul_mirror_store(m);
   sph_status st = rebuild(m, err);
   m->lf.have_rates = 0; /* the rates of the new reference */
   m->since = 0.0;
@@ -313,6 +317,10 @@ static void ul_csph_destroy(sph_sim *sim) {
   free(m->f0);
   free(m->S);
   free(m->dp);
+  free(m->imgj);
+  free(m->imgX);
+  free(m->gj);
+  free(m->placed);
   free(m);
   sim->method_data = NULL;
 }
@@ -385,6 +393,7 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_domain_track(sim->domain, m->ref.X, 3, err));
   SPH_TRY(sph_domain_track(sim->domain, m->Fr, 9, err));
   SPH_TRY(sph_domain_track(sim->domain, m->V0, 1, err));
+  SPH_TRY(ul_mirror_setup(m, err));
   SPH_TRY(rebuild(m, err));
   return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,
                             ul_csph_constrain, m, err);
@@ -409,6 +418,10 @@ static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
 
 static sph_status ul_csph_restore(sph_sim *sim, sph_error *err) {
   ul_csph *m = sim->method_data;
+  if (m->ref.all_images)
+    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
+                         "ul-csph with symmetry planes over MPI ranks does "
+                         "not resume from a checkpoint yet");
   double t0 = sph_wtime();
   sph_status st = rebuild(m, err);
   sim->timers[m->timer_update].seconds += sph_wtime() - t0;
