@@ -379,11 +379,11 @@ static int box_near(const sph_domain_plane *p, const double *lo,
 }
 
 size_t sph_domain_mirror_boxes(const sph_domain_plane *planes, int np,
-                               double near, double tol, double *box,
+                               double near, double tol, int passes, double *box,
                                size_t max) {
   size_t nb = 1;
   int grew = 1;
-  for (int pass = 0; grew && pass < 16; ++pass) {
+  for (int pass = 0; grew && pass < passes; ++pass) {
     grew = 0;
     for (int k = 0; k < np; ++k)
       for (size_t b = 0, count = nb; b < count; ++b) {
@@ -432,7 +432,7 @@ static sph_status find_mirror_ghosts(const sph_particles *ps, const int *owner,
   for (int c = ps->dim; c < 3; ++c)
     box[c] = box[3 + c] = 0.0;
   size_t nb = sph_domain_mirror_boxes(planes, np, 4.0 * support, 1e-9 * support,
-                                      box, SPH_DOMAIN_MIRROR_BOXES);
+                                      16, box, SPH_DOMAIN_MIRROR_BOXES);
   int full = nb == 0;
   double w = 2.0 * support;
   for (size_t i = 0; i < N; ++i) {

@@ -417,8 +417,9 @@ static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
     double w = y->depth * radius;
     if (y->np && q != d->rank) {
       memcpy(y->mbox, b, 6 * sizeof *b);
+      /* two passes, as the images are made (methods/tl_common.c) */
       nb = sph_domain_mirror_boxes(y->planes, y->np, w + 2.0 * radius,
-                                   1e-9 * radius, y->mbox,
+                                   1e-9 * radius, 2, y->mbox,
                                    SPH_DOMAIN_MIRROR_BOXES);
       w = nb ? w : INFINITY; /* boxes that never settle: every particle */
       nb = nb ? nb : 1;
