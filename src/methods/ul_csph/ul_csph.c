@@ -402,8 +402,8 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
   ul_csph *m = sim->method_data;
   size_t n = m->ref.n, ne = m->ref.n_ext;
-  /* over MPI ranks (no images): the owned points, also while a checkpoint
-   * is read (the ghosts' come from their owners) */
+  /* over MPI ranks: the owned points, also while a checkpoint is read
+   * (the ghosts' come from their owners, the images' from their sources) */
   if (sim->domain)
     n = ne = sim->ps->n;
   out[0] = (sph_state_array){"x", m->x, 3 * n};
@@ -418,10 +418,6 @@ static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
 
 static sph_status ul_csph_restore(sph_sim *sim, sph_error *err) {
   ul_csph *m = sim->method_data;
-  if (m->ref.all_images)
-    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
-                         "ul-csph with symmetry planes over MPI ranks does "
-                         "not resume from a checkpoint yet");
   double t0 = sph_wtime();
   sph_status st = rebuild(m, err);
   sim->timers[m->timer_update].seconds += sph_wtime() - t0;

@@ -45,7 +45,7 @@ sph_status ul_mirror_setup(ul_csph *m, sph_error *err) {
   m->placed = malloc((K * cap + 1) * sizeof *m->placed);
   if (!m->imgj || !m->imgX || !m->gj || !m->placed)
     return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph mirror images");
-  for (size_t i = 0; i < K * n; ++i)
+  for (size_t i = 0; i < K * cap; ++i)
     m->imgj[i] = -1.0;
   /* the owned particles come in storage order at set-up */
   const int64_t *gidx = sph_domain_storage_index(sim->domain);
