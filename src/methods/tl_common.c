@@ -558,7 +558,9 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
   return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
 }
 
-sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+/* the lists (sorted in the serial order over ranks), w's room and the
+ * corrections of the points whose lists are whole */
+static sph_status rebuild_local(tl_reference *ref, const sph_sim *sim,
                                 sph_error *err) {
   const sph_scene *s = sim->scene;
   size_t ne = ref->n_ext;
@@ -580,15 +582,22 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
     ref->w_cap = cap;
   }
   /* ghosts lack part of their neighbourhood: their L comes from the owner */
-  sph_cloud cloud = {.n = sim->domain ? ref->n_img : ne,
+  size_t whole = ref->n_whole ? ref->n_whole : ref->n_img;
+  sph_cloud cloud = {.n = sim->domain ? whole : ne,
                      .dim = s->dimension,
                      .x = ref->X,
                      .volume = ref->V,
                      .id = ref->id,
                      .nl = ref->nl,
                      .kernel = &sim->kernel};
-  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL,
-                                  ref->L, err));
+  return sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL, ref->L,
+                                 err);
+}
+
+sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+                                sph_error *err) {
+  /* a rank that fails alone must not leave the others in the exchange */
+  SPH_TRY(sph_domain_agree(sim->domain, rebuild_local(ref, sim, err), err));
   SPH_TRY(sph_domain_exchange(sim->domain, ref->L, 9, err));
   pair_weights(ref, &sim->kernel);
   return SPH_OK;

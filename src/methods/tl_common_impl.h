@@ -81,6 +81,9 @@ typedef struct tl_reference {
   int sync_images;
   /* over MPI ranks with a dynamic domain and planes, else NULL */
   tl_images *all_images;
+  /* over MPI ranks: the points from 0 whose lists are whole, so their
+   * corrections are computed here (0: n_img) */
+  size_t n_whole;
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as

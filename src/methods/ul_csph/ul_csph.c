@@ -162,7 +162,8 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
       return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph stabilisation");
     m->slot_cap = cap;
   }
-  SPH_TRY(tl_reference_reverse_fill(ref, m->rev, err));
+  SPH_TRY(sph_domain_agree(m->sim->domain,
+                           tl_reference_reverse_fill(ref, m->rev, err), err));
   int dim = m->sim->scene->dimension;
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)

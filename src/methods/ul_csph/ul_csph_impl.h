@@ -9,6 +9,7 @@
 typedef struct ul_placed {
   int64_t j;
   size_t s, k;
+  int far; /* beyond two supports of the owned box: a partial list */
 } ul_placed;
 
 typedef struct ul_csph {

@@ -2,9 +2,11 @@
  * the serial run's mirror images are fixed at set-up (tl_images, seed 000
  * sec. 8.2 / BENCHMARKS.md D.1), each carried by its source particle (its
  * serial number and reference position move with it), and at every rebuild
- * a rank places, in the serial images' order between its owned particles
- * and its ghosts, the images of its owned particles and those within three
- * supports of its owned box, so every pair sum runs in the serial order. */
+ * a rank places, between its owned particles and its ghosts, the images of
+ * its owned particles and those within three supports of its owned box
+ * (those within two first, whose lists are whole, so their corrections are
+ * computed here), keyed by their serial order, by which every pair sum
+ * runs. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,12 +16,26 @@
 
 /* supports around the owned box within which images are placed (the ghosts'
  * depth, solver/sim.c): an image near an owned particle reads its
- * neighbours' corrections, whose own lists reach a third support */
+ * neighbours' corrections, whose own lists reach a third support; those
+ * within two supports have whole lists */
 #define UL_MIRROR_DEPTH 3.0
+#define UL_MIRROR_WHOLE 2.0
 
+/* the images with whole lists first, each group in the serial order */
 static int cmp_placed(const void *pa, const void *pb) {
   const ul_placed *a = pa, *b = pb;
+  if (a->far != b->far)
+    return a->far - b->far;
   return (a->j > b->j) - (a->j < b->j);
+}
+
+/* whether X lies in the box lo, hi widened by w */
+static int in_box(const double *lo, const double *hi, double w,
+                  const double *X) {
+  int in = 1;
+  for (int d = 0; d < 3; ++d)
+    in &= X[d] >= lo[d] - w && X[d] <= hi[d] + w;
+  return in;
 }
 
 static int cmp_index(const void *pa, const void *pb) {
@@ -107,23 +123,22 @@ sph_status ul_mirror_place(ul_csph *m, sph_error *err) {
   memcpy(m->p, ps->field[SPH_FIELD_MOMENTUM], 3 * nr * sizeof *m->p);
   memcpy(m->F, ps->field[SPH_FIELD_DEFGRAD], 9 * nr * sizeof *m->F);
   double lo[3] = {INFINITY, INFINITY, INFINITY},
-         hi[3] = {-INFINITY, -INFINITY, -INFINITY},
-         w = UL_MIRROR_DEPTH * sim->kernel.support;
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY}, h = sim->kernel.support;
   for (size_t a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c) {
-      lo[c] = fmin(lo[c], ref->X[3 * a + c] - w);
-      hi[c] = fmax(hi[c], ref->X[3 * a + c] + w);
+      lo[c] = fmin(lo[c], ref->X[3 * a + c]);
+      hi[c] = fmax(hi[c], ref->X[3 * a + c]);
     }
   /* the images of the owned particles and those near them */
-  size_t c = 0;
+  size_t c = 0, whole = 0;
   for (size_t s = 0; s < nr; ++s)
     for (size_t k = 0; k < K && m->imgj[K * s + k] >= 0.0; ++k) {
       const double *Xi = m->imgX + 3 * (K * s + k);
-      int near = 1;
-      for (int d = 0; d < 3; ++d)
-        near &= Xi[d] >= lo[d] && Xi[d] <= hi[d];
-      if (s < n || near)
-        m->placed[c++] = (ul_placed){(int64_t)m->imgj[K * s + k], s, k};
+      int far = !in_box(lo, hi, UL_MIRROR_WHOLE * h, Xi);
+      if (s < n || in_box(lo, hi, UL_MIRROR_DEPTH * h, Xi)) {
+        m->placed[c++] = (ul_placed){(int64_t)m->imgj[K * s + k], s, k, far};
+        whole += !far;
+      }
     }
   sph_status st = SPH_OK;
   if (nr + c > ref->cap)
@@ -173,6 +188,7 @@ sph_status ul_mirror_place(ul_csph *m, sph_error *err) {
   }
   ref->n_img = n + c;
   ref->n_ext = nr + c;
+  ref->n_whole = n + whole;
   sph_domain_set_ghost_base(sim->domain, n + c);
   ref->mirror = (sph_mirror){.n_real = n,
                              .n_ghost = c,
