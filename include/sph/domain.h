@@ -167,6 +167,19 @@ sph_status sph_domain_track(sph_domain *d, double *array, int ncomp,
  * the ghosts' values follow it in every field and tracked array. */
 sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
                               sph_error *err);
+/* Symmetry planes of a dynamic domain's run (nothing for NULL or a fixed
+ * domain): its rebuilds take as ghosts the other ranks' particles within
+ * `depth` radii of the box of a rank's owned particles or of the box's
+ * reflections (chained over the planes, each within depth + 2 radii of its
+ * plane, where the images' sources lie), so a rank holds the sources of
+ * the images near its particles and their neighbourhoods. */
+sph_status sph_domain_dyn_mirror(sph_domain *d, const sph_domain_plane *planes,
+                                 int np, double depth, sph_error *err);
+/* Every rank's owned particles' w values (mine, w a particle) into all (w
+ * per particle of the whole set, by storage index); collective, set-up use
+ * (it allocates). Nothing for NULL or a fixed domain. */
+sph_status sph_domain_allgather(sph_domain *d, const double *mine, int w,
+                                double *all, sph_error *err);
 /* Sets the ghosts' values of `count` arrays (ncomp[i] doubles a particle,
  * at most 32 doubles in all) in one message per neighbour rank. */
 sph_status sph_domain_exchange_many(sph_domain *d, double *const *fields,

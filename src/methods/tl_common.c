@@ -326,6 +326,96 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
   return SPH_OK;
 }
 
+/* Over MPI ranks with a dynamic domain: the serial images built over the
+ * whole set (gathered), kept as r->all_images; the local points are the
+ * owned particles, with room for the images the method places. */
+static sph_status build_images_dynamic(tl_reference *r, sph_sim *sim,
+                                       sph_error *err) {
+  sph_particles *ps = sim->ps;
+  sph_domain *dom = sim->domain;
+  size_t n = ps->n;
+  double count = (double)n;
+  sph_domain_sum(dom, &count, 1);
+  size_t N = (size_t)count;
+  double *mine = malloc((5 * n + 1) * sizeof *mine);
+  double *all = malloc((5 * N + 1) * sizeof *all);
+  sph_particles *full = NULL;
+  tl_reference g = {0};
+  tl_images *t = calloc(1, sizeof *t);
+  sph_status st = mine && all && t
+                      ? SPH_OK
+                      : sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+  for (size_t a = 0; st == SPH_OK && a < n; ++a) {
+    memcpy(mine + 5 * a, ps->field[SPH_FIELD_POSITION0] + 3 * a,
+           3 * sizeof *mine);
+    mine[5 * a + 3] = ps->field[SPH_FIELD_VOLUME0][a];
+    mine[5 * a + 4] = (double)ps->body[a];
+  }
+  if (st == SPH_OK)
+    st = sph_domain_allgather(dom, mine, 5, all, err);
+  if (st == SPH_OK)
+    st = sph_particles_create(&full, N, ps->dim, err);
+  if (st == SPH_OK)
+    st = sph_particles_require(full, SPH_FIELD_POSITION0, err);
+  if (st == SPH_OK)
+    st = sph_particles_require(full, SPH_FIELD_VOLUME0, err);
+  if (st == SPH_OK) {
+    full->n = N;
+    for (size_t i = 0; i < N; ++i) {
+      memcpy(full->field[SPH_FIELD_POSITION0] + 3 * i, all + 5 * i,
+             3 * sizeof *all);
+      full->field[SPH_FIELD_VOLUME0][i] = all[5 * i + 3];
+      full->body[i] = (int32_t)all[5 * i + 4];
+    }
+    sph_sim serial = *sim; /* the serial run's images */
+    serial.ps = full;
+    serial.domain = NULL;
+    st = build_images(&g, &serial, 1, err);
+  }
+  size_t M = st == SPH_OK ? g.n_img - N : 0;
+  int *per = NULL;
+  if (st == SPH_OK) {
+    t->m = M;
+    t->n_real = N;
+    t->src = malloc((M + 1) * sizeof *t->src);
+    t->vsign = malloc(3 * M + 1);
+    t->rsign = malloc(3 * M + 1);
+    t->ssign = malloc(M + 1);
+    t->X = malloc((3 * M + 1) * sizeof *t->X);
+    t->vmat = g.vmat ? malloc((9 * M + 1) * sizeof *t->vmat) : NULL;
+    per = calloc(N + 1, sizeof *per);
+    if (!t->src || !t->vsign || !t->rsign || !t->ssign || !t->X || !per ||
+        (g.vmat && !t->vmat))
+      st = sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+  }
+  for (size_t j = 0; st == SPH_OK && j < M; ++j) {
+    size_t i = N + j;
+    t->src[j] = g.src[i];
+    memcpy(t->vsign + 3 * j, g.vsign + 3 * i, 3);
+    memcpy(t->rsign + 3 * j, g.rsign + 3 * i, 3);
+    t->ssign[j] = g.ssign[i];
+    memcpy(t->X + 3 * j, g.X + 3 * i, 3 * sizeof *t->X);
+    if (t->vmat)
+      memcpy(t->vmat + 9 * j, g.vmat + 9 * i, 9 * sizeof *t->vmat);
+    int c = ++per[g.src[i]];
+    t->k = c > t->k ? c : t->k;
+  }
+  free(per);
+  free(mine);
+  free(all);
+  sph_particles_destroy(full);
+  tl_reference_destroy(&g);
+  r->all_images = t;
+  SPH_TRY(st);
+  SPH_TRY(build_images(r, sim, 0, err));
+  size_t cap = 0;
+  r->cap += M;
+  SPH_TRY(grow_points(r, r->cap, &cap, t->vmat != NULL, err));
+  if (!(r->key = malloc(r->cap * sizeof *r->key)))
+    return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+  return SPH_OK;
+}
+
 /* ---- reference configuration
  * -------------------------------------------------- */
 
@@ -468,7 +558,9 @@ sph_status tl_reference_alloc(const tl_reference *ref, size_t ncomp,
   return *out ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "state arrays");
 }
 
-sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+/* the lists (sorted in the serial order over ranks), w's room and the
+ * corrections of the points whose lists are whole */
+static sph_status rebuild_local(tl_reference *ref, const sph_sim *sim,
                                 sph_error *err) {
   const sph_scene *s = sim->scene;
   size_t ne = ref->n_ext;
@@ -490,15 +582,22 @@ sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
     ref->w_cap = cap;
   }
   /* ghosts lack part of their neighbourhood: their L comes from the owner */
-  sph_cloud cloud = {.n = sim->domain ? ref->n_img : ne,
+  size_t whole = ref->n_whole ? ref->n_whole : ref->n_img;
+  sph_cloud cloud = {.n = sim->domain ? whole : ne,
                      .dim = s->dimension,
                      .x = ref->X,
                      .volume = ref->V,
                      .id = ref->id,
                      .nl = ref->nl,
                      .kernel = &sim->kernel};
-  SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL,
-                                  ref->L, err));
+  return sph_correction_gradient(&cloud, SPH_GRAD_CORRECTED, NULL, NULL, ref->L,
+                                 err);
+}
+
+sph_status tl_reference_rebuild(tl_reference *ref, const sph_sim *sim,
+                                sph_error *err) {
+  /* a rank that fails alone must not leave the others in the exchange */
+  SPH_TRY(sph_domain_agree(sim->domain, rebuild_local(ref, sim, err), err));
   SPH_TRY(sph_domain_exchange(sim->domain, ref->L, 9, err));
   pair_weights(ref, &sim->kernel);
   return SPH_OK;
@@ -532,7 +631,14 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   sph_particles *ps = sim->ps;
   int timer = sph_sim_add_timer(sim, "corrections");
   double t0 = sph_wtime();
-  SPH_TRY(build_images(ref, sim, images, err));
+  int planes = 0;
+  for (size_t k = 0; images && k < s->nboundaries; ++k)
+    planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+              s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY;
+  if (planes && sph_domain_migrates(sim->domain))
+    SPH_TRY(build_images_dynamic(ref, sim, err));
+  else
+    SPH_TRY(build_images(ref, sim, images, err));
   size_t n = ref->n, ne = ref->n_ext;
   if (ref->n_img > n)
     sim->mirror = &ref->mirror;
@@ -572,7 +678,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   for (int i = 0; i < s->output.nfields; ++i)
     if (s->output.fields[i] == SPH_FIELD_ACCELERATION)
       SPH_TRY(sph_particles_require(ps, SPH_FIELD_ACCELERATION, err));
-  ref->owns_state = ne > n;
+  ref->owns_state = ne > n || ref->all_images;
   if (ref->owns_state) {
     SPH_TRY(tl_reference_alloc(ref, 3, &ref->x, err));
     SPH_TRY(tl_reference_alloc(ref, 3, &ref->p, err));
@@ -645,6 +751,15 @@ void tl_reference_destroy(tl_reference *ref) {
   free(ref->vmat);
   free(ref->key);
   free(ref->axes);
+  if (ref->all_images) {
+    free(ref->all_images->src);
+    free(ref->all_images->vsign);
+    free(ref->all_images->rsign);
+    free(ref->all_images->ssign);
+    free(ref->all_images->vmat);
+    free(ref->all_images->X);
+    free(ref->all_images);
+  }
   if (ref->owns_state) {
     free(ref->x);
     free(ref->p);

@@ -28,6 +28,20 @@
    1ul << SPH_FIELD_PRESSURE | 1ul << SPH_FIELD_VON_MISES |                    \
    1ul << SPH_FIELD_DISPLACEMENT)
 
+/* The serial run's mirror images, fixed at set-up, of a run over MPI ranks
+ * with a dynamic domain (the method places those near a rank's particles
+ * at each rebuild): image j is point n_real + j of the serial run, with
+ * its source's storage index, signs (or reflection matrix) and initial
+ * reference position; k is the most images of one source. */
+typedef struct tl_images {
+  size_t m, n_real;
+  int k;
+  int32_t *src;
+  signed char *vsign, *rsign, *ssign; /* 3, 3, 1 per image */
+  double *vmat;                       /* 9 per image, or NULL */
+  double *X;                          /* 3 per image */
+} tl_images;
+
 typedef struct tl_reference {
   size_t n, n_ext;   /* real particles, real + mirror images + ghosts */
   size_t n_img;      /* real + mirror images; the ghosts of a distributed run
@@ -65,6 +79,11 @@ typedef struct tl_reference {
   /* over MPI ranks with mirror images, whose sources may be ghosts: the
    * ghosts' state is exchanged before the images are refreshed */
   int sync_images;
+  /* over MPI ranks with a dynamic domain and planes, else NULL */
+  tl_images *all_images;
+  /* over MPI ranks: the points from 0 whose lists are whole, so their
+   * corrections are computed here (0: n_img) */
+  size_t n_whole;
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as

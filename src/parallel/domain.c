@@ -433,7 +433,35 @@ static int box_near(const sph_domain_plane *p, const double *lo,
   return dmin < layer && dmax > -layer;
 }
 
-#define MIRROR_BOXES 4096
+size_t sph_domain_mirror_boxes(const sph_domain_plane *planes, int np,
+                               double near, double tol, int passes, double *box,
+                               size_t max) {
+  size_t nb = 1;
+  int grew = 1;
+  for (int pass = 0; grew && pass < passes; ++pass) {
+    grew = 0;
+    for (int k = 0; k < np; ++k)
+      for (size_t b = 0, count = nb; b < count; ++b) {
+        double img[6];
+        if (!box_near(&planes[k], box + 6 * b, box + 6 * b + 3, near))
+          continue;
+        reflect_box(&planes[k], box + 6 * b, box + 6 * b + 3, img);
+        int seen = 0;
+        for (size_t e = 0; e < nb && !seen; ++e) {
+          seen = 1;
+          for (int c = 0; c < 6; ++c)
+            seen &= fabs(box[6 * e + c] - img[c]) <= tol;
+        }
+        if (seen)
+          continue;
+        if (nb == max)
+          return 0;
+        memcpy(box + 6 * nb++, img, sizeof img);
+        grew = 1;
+      }
+  }
+  return nb;
+}
 
 /* the ghosts mirror images need (sph_domain_create_mirrored): the box of
  * the owned particles and its reflections across every plane it comes
@@ -444,9 +472,9 @@ static sph_status find_mirror_ghosts(const sph_particles *ps, const int *owner,
                                      int r, double support,
                                      const sph_domain_plane *planes, int np,
                                      char *ghost, sph_error *err) {
-  size_t N = ps->n, nb = 1;
+  size_t N = ps->n;
   const double *X = ps->field[SPH_FIELD_POSITION0];
-  double *box = malloc(6 * MIRROR_BOXES * sizeof *box);
+  double *box = malloc(6 * SPH_DOMAIN_MIRROR_BOXES * sizeof *box);
   if (!box)
     return sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
   for (int c = 0; c < 3; ++c)
@@ -458,32 +486,9 @@ static sph_status find_mirror_ghosts(const sph_particles *ps, const int *owner,
     }
   for (int c = ps->dim; c < 3; ++c)
     box[c] = box[3 + c] = 0.0;
-  double tol = 1e-9 * support;
-  int grew = 1, full = 0;
-  for (int pass = 0; grew && !full && pass < 16; ++pass) {
-    grew = 0;
-    for (int k = 0; k < np && !full; ++k)
-      for (size_t b = 0, count = nb; b < count && !full; ++b) {
-        double img[6];
-        if (!box_near(&planes[k], box + 6 * b, box + 6 * b + 3, 4.0 * support))
-          continue;
-        reflect_box(&planes[k], box + 6 * b, box + 6 * b + 3, img);
-        int seen = 0;
-        for (size_t e = 0; e < nb && !seen; ++e) {
-          seen = 1;
-          for (int c = 0; c < 6; ++c)
-            seen &= fabs(box[6 * e + c] - img[c]) <= tol;
-        }
-        if (seen)
-          continue;
-        if (nb == MIRROR_BOXES) {
-          full = 1;
-          break;
-        }
-        memcpy(box + 6 * nb++, img, sizeof img);
-        grew = 1;
-      }
-  }
+  size_t nb = sph_domain_mirror_boxes(planes, np, 4.0 * support, 1e-9 * support,
+                                      16, box, SPH_DOMAIN_MIRROR_BOXES);
+  int full = nb == 0;
   double w = 2.0 * support;
   for (size_t i = 0; i < N; ++i) {
     if (owner[i] == r || ghost[i])

@@ -44,6 +44,11 @@ struct sph_domain_dyn {
   double halo_max, ghosts_max; /* the largest halo and ghost layer */
   double *ckpt;                /* a checkpoint's domain state (ckpt_len) */
   int resumed; /* the next rebuild sends the checkpoint's ghosts */
+  /* symmetry planes: ghosts also around the box's reflections */
+  sph_domain_plane planes[32];
+  int np;
+  double depth; /* supports around each box */
+  double *mbox; /* the boxes of one rank (SPH_DOMAIN_MIRROR_BOXES) */
 };
 
 size_t sph_domain_dyn_capacity(size_t N, int R) {
@@ -69,6 +74,7 @@ void sph_domain_dyn_destroy(sph_domain_dyn *y) {
   free(y->count);
   free(y->work);
   free(y->ckpt);
+  free(y->mbox);
   free(y);
 }
 
@@ -341,7 +347,17 @@ static sph_status send_ghosts(sph_domain *d, sph_particles *ps, size_t k,
   return SPH_OK;
 }
 
-/* the other ranks' particles in this rank's box widened by radius, as
+/* whether x lies within w of one of the nb boxes */
+static int in_boxes(const double *b, size_t nb, double w, const double *x) {
+  for (size_t k = 0; k < nb; ++k, b += 6)
+    if (x[0] >= b[0] - w && x[1] >= b[1] - w && x[2] >= b[2] - w &&
+        x[0] <= b[3] + w && x[1] <= b[4] + w && x[2] <= b[5] + w)
+      return 1;
+  return 0;
+}
+
+/* the other ranks' particles in this rank's box widened by radius (with
+ * symmetry planes: within depth radii of the box or of its reflections), as
  * ghosts after the owned ones */
 static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
                               sph_error *err) {
@@ -349,22 +365,36 @@ static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
   int R = d->size;
   size_t n = d->n;
   const double *x = ps->field[SPH_FIELD_POSITION];
+  double pad = y->np ? 0.0 : radius;
   double box[6] = {INFINITY,  INFINITY,  INFINITY,
                    -INFINITY, -INFINITY, -INFINITY};
   for (size_t a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c) {
-      box[c] = fmin(box[c], x[3 * a + c] - radius);
-      box[3 + c] = fmax(box[3 + c], x[3 * a + c] + radius);
+      box[c] = fmin(box[c], x[3 * a + c] - pad);
+      box[3 + c] = fmax(box[3 + c], x[3 * a + c] + pad);
     }
   MPI_Allgather(box, 6, MPI_DOUBLE, y->box, 6, MPI_DOUBLE, MPI_COMM_WORLD);
   size_t k = 0;
   for (int q = 0; q < R; ++q) {
     y->cs[q] = 0;
     const double *b = y->box + 6 * q;
+    size_t nb = 1;
+    double w = y->depth * radius;
+    if (y->np && q != d->rank) {
+      memcpy(y->mbox, b, 6 * sizeof *b);
+      /* two passes, as the images are made (methods/tl_common.c) */
+      nb = sph_domain_mirror_boxes(y->planes, y->np, w + 2.0 * radius,
+                                   1e-9 * radius, 2, y->mbox,
+                                   SPH_DOMAIN_MIRROR_BOXES);
+      w = nb ? w : INFINITY; /* boxes that never settle: every particle */
+      nb = nb ? nb : 1;
+      b = y->mbox;
+    }
     for (size_t a = 0; q != d->rank && a < n; ++a) {
       const double *p = x + 3 * a;
-      if (p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] ||
-          p[1] > b[4] || p[2] > b[5])
+      if (y->np ? !in_boxes(b, nb, w, p)
+                : p[0] < b[0] || p[1] < b[1] || p[2] < b[2] || p[0] > b[3] ||
+                      p[1] > b[4] || p[2] > b[5])
         continue;
       if (k < y->cap)
         d->send_idx[k] = (int32_t)a;
@@ -373,6 +403,60 @@ static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
     }
   }
   return send_ghosts(d, ps, k, err);
+}
+
+sph_status sph_domain_dyn_mirror(sph_domain *d, const sph_domain_plane *planes,
+                                 int np, double depth, sph_error *err) {
+  if (!d || !d->dyn || np <= 0)
+    return SPH_OK;
+  sph_domain_dyn *y = d->dyn;
+  if (np > (int)(sizeof y->planes / sizeof *y->planes))
+    return sph_error_set(err, SPH_ERR_RANGE, "domain: at most %d planes",
+                         (int)(sizeof y->planes / sizeof *y->planes));
+  free(y->mbox);
+  y->mbox = malloc(6 * SPH_DOMAIN_MIRROR_BOXES * sizeof *y->mbox);
+  if (!y->mbox)
+    return sph_error_set(err, SPH_ERR_NOMEM, "dynamic domain");
+  memcpy(y->planes, planes, (size_t)np * sizeof *planes);
+  y->np = np;
+  y->depth = depth;
+  return SPH_OK;
+}
+
+sph_status sph_domain_allgather(sph_domain *d, const double *mine, int w,
+                                double *all, sph_error *err) {
+  if (!d || !d->dyn)
+    return SPH_OK;
+  int R = d->size, n = (int)d->n * (w + 1);
+  int *cnt = malloc(2 * (size_t)R * sizeof *cnt);
+  double *o = malloc(((size_t)n + 1) * sizeof *o);
+  double *in = malloc((d->dyn->N * (size_t)(w + 1) + 1) * sizeof *in);
+  sph_status st =
+      cnt && o && in ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "gather");
+  st = sph_domain_agree(d, st, err);
+  if (st == SPH_OK) {
+    /* records of the storage index and the w values */
+    for (size_t a = 0; a < d->n; ++a) {
+      o[(size_t)(w + 1) * a] = (double)d->gidx[a];
+      memcpy(o + (size_t)(w + 1) * a + 1, mine + (size_t)w * a,
+             (size_t)w * sizeof *o);
+    }
+    MPI_Allgather(&n, 1, MPI_INT, cnt, 1, MPI_INT, MPI_COMM_WORLD);
+    int at = 0;
+    for (int q = 0; q < R; ++q) {
+      cnt[R + q] = at;
+      at += cnt[q];
+    }
+    MPI_Allgatherv(o, n, MPI_DOUBLE, in, cnt, cnt + R, MPI_DOUBLE,
+                   MPI_COMM_WORLD);
+    for (int i = 0; i < at; i += w + 1)
+      memcpy(all + (size_t)w * (size_t)in[i], in + i + 1,
+             (size_t)w * sizeof *all);
+  }
+  free(cnt);
+  free(o);
+  free(in);
+  return st;
 }
 
 sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
@@ -586,6 +670,18 @@ sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
 sph_status sph_domain_rebuild(sph_domain *d, sph_particles *ps, double radius,
                               sph_error *err) {
   (void)d, (void)ps, (void)radius, (void)err;
+  return SPH_OK;
+}
+
+sph_status sph_domain_dyn_mirror(sph_domain *d, const sph_domain_plane *planes,
+                                 int np, double depth, sph_error *err) {
+  (void)d, (void)planes, (void)np, (void)depth, (void)err;
+  return SPH_OK;
+}
+
+sph_status sph_domain_allgather(sph_domain *d, const double *mine, int w,
+                                double *all, sph_error *err) {
+  (void)d, (void)mine, (void)w, (void)all, (void)err;
   return SPH_OK;
 }
 

@@ -60,6 +60,16 @@ void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
                             int dim, int *owner, int *axis, double *cut,
                             uint64_t *work);
 
+/* The box lo, hi (box[0..5]) and its reflections across every plane it
+ * comes within `near` of, chained over at most `passes` passes over the
+ * planes or until no new box appears (boxes equal within tol are one),
+ * into box (6 each, room for max): their count, 0 when they do not settle
+ * within max. */
+#define SPH_DOMAIN_MIRROR_BOXES 4096
+size_t sph_domain_mirror_boxes(const sph_domain_plane *planes, int np,
+                               double near, double tol, int passes, double *box,
+                               size_t max);
+
 /* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
  * over R ranks; the dynamic state from the first partition (the particle
  * count and the cut tree, axis and cut R + 1 each: nothing N-sized is

@@ -142,12 +142,6 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     const sph_boundary *bc = &s->boundaries[k];
     if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
       continue;
-    if (sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC)
-      return sph_node_error(bcs && k < bcs->count ? bcs->items[k] : s->root,
-                            err, SPH_ERR_UNSUPPORTED,
-                            "symmetry planes (mirror images) do not run over "
-                            "MPI ranks yet with %s; run without mpirun",
-                            sim->method->name);
     if (np == (int)(sizeof planes / sizeof *planes))
       return sph_node_error(bcs && k < bcs->count ? bcs->items[k] : s->root,
                             err, SPH_ERR_UNSUPPORTED,
@@ -157,6 +151,14 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     planes[np] =
         (sph_domain_plane){.at = bc->select.at, .axis = bc->select.axis};
     memcpy(planes[np++].n, bc->select.normal, sizeof planes->n);
+  }
+  /* updated Lagrangian: ghosts within three supports of the box and its
+   * reflections, as an image's stabilised force matrix reads its
+   * neighbours' corrections (methods/ul_csph) */
+  if (np && sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
+    SPH_TRY(sph_domain_create_dynamic(&sim->domain, &sim->ps,
+                                      sim->kernel.support, err));
+    return sph_domain_dyn_mirror(sim->domain, planes, np, 3.0, err);
   }
   if (np)
     return sph_domain_create_mirrored(&sim->domain, &sim->ps,

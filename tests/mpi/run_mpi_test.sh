@@ -37,8 +37,9 @@ no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
 check "no stale pieces" no_stale
 
 # refusals: exit 2 on every rank, the folder never made
-expect="symmetry planes (mirror images) do not run over MPI ranks yet with ul-csph"
-check "ul-csph symmetry planes refused" refused run punch_ul_csph --quiet
+expect="contact between bodies does not run over MPI ranks with tl-csph"
+check "tl-csph pairs of bodies refused" refused run rubber_rings_ul_csph \
+  --quiet --set 'method={name: tl-csph}'
 expect="more than useful"
 np=4 check "too many ranks refused" refused run twisting_column --quiet \
   --set 'method={name: tl-csph}' --set 'bodies.0.particles.count=[3,7,3]'

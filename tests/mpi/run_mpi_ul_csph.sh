@@ -7,10 +7,10 @@
 # update migrates the particles (the bar's moving end crosses the cut planes)
 # and finds the ghosts again; their x, f0, F and stabilised force matrices
 # come from their owners, so every pair sum runs in the serial order. The
-# punch's symmetry planes are mirror images, refused over ranks, so the 2D
-# path runs the punch with rollers on those planes; the same rank count twice
-# writes the same bytes; the punch as shipped is refused (the contact term of
-# the rings: run_mpi_contact.sh).
+# 2D path runs the punch with rollers on its symmetry planes (its mirror
+# images over ranks: run_mpi_symmetry.sh); the same rank count twice writes
+# the same bytes; pairs of bodies with tl-csph are refused (the contact term
+# of the rings: run_mpi_contact.sh).
 # Usage: run_mpi_ul_csph.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -40,6 +40,7 @@ check "bar np 4 twice: identical files" same_bytes "$work/bar.np4" \
   "$work/bar.np4b"
 
 # refusals: exit 2 on every rank, the folder never made
-expect="symmetry planes (mirror images) do not run over MPI ranks yet"
-check "punch with symmetry planes refused" refused run punch_ul_csph --quiet
+expect="contact between bodies does not run over MPI ranks with tl-csph"
+check "tl-csph pairs of bodies refused" refused run rubber_rings_ul_csph \
+  --quiet --set 'method={name: tl-csph}'
 summary

@@ -31,9 +31,10 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
   /* a ghost's list is partial: its stabilised force matrix is its owner's */
   long nq = dom ? (long)ref->n_img : ne;
   int dim = m->sim->scene->dimension, stab = m->eta > 0.0;
+  /* an image's source may be a ghost: its state first */
+  SPH_TRY(sph_domain_exchange(dom, m->x, 3, err));
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  SPH_TRY(sph_domain_exchange(dom, m->x, 3, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     tl_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
@@ -48,9 +49,9 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
       ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
   }
   if (stab) {
+    SPH_TRY(sph_domain_exchange(dom, m->f0, 9, err));
     if (ne > n)
       tl_mirror_refresh(ref, m->x, m->p, m->f0, NULL, NULL);
-    SPH_TRY(sph_domain_exchange(dom, m->f0, 9, err));
 #pragma omp parallel for schedule(static)
     for (long a = 0; a < n; ++a) {
       double acc[9] = {0}, f[9];
@@ -66,9 +67,9 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
       ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
     }
   }
+  SPH_TRY(sph_domain_exchange(dom, m->F, 9, err));
   if (ne > n)
     tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
-  SPH_TRY(sph_domain_exchange(dom, m->F, 9, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];
@@ -161,7 +162,8 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
       return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph stabilisation");
     m->slot_cap = cap;
   }
-  SPH_TRY(tl_reference_reverse_fill(ref, m->rev, err));
+  SPH_TRY(sph_domain_agree(m->sim->domain,
+                           tl_reference_reverse_fill(ref, m->rev, err), err));
   int dim = m->sim->scene->dimension;
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
@@ -222,7 +224,9 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
  * V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
 static sph_status rebuild(ul_csph *m, sph_error *err) {
   tl_reference *ref = &m->ref;
+  ul_mirror_sync(m);
   SPH_TRY(tl_reference_redistribute(ref, m->sim, err));
+  SPH_TRY(ul_mirror_place(m, err));
   m->lf.n = ref->n;
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
@@ -245,6 +249,7 @@ static sph_status reference_update(ul_csph *m, sph_error *err) {
   SPH_TRY(deformation_and_stress(m, (long)ref->n, err));
   memcpy(ref->X, m->x, 3 * ref->n_ext * sizeof *ref->X);
   memcpy(m->Fr, m->F, 9 * ref->n_ext * sizeof *m->Fr);
+  ul_mirror_store(m);
   sph_status st = rebuild(m, err);
   m->lf.have_rates = 0; /* the rates of the new reference */
   m->since = 0.0;
@@ -313,6 +318,10 @@ static void ul_csph_destroy(sph_sim *sim) {
   free(m->f0);
   free(m->S);
   free(m->dp);
+  free(m->imgj);
+  free(m->imgX);
+  free(m->gj);
+  free(m->placed);
   free(m);
   sim->method_data = NULL;
 }
@@ -385,6 +394,7 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_domain_track(sim->domain, m->ref.X, 3, err));
   SPH_TRY(sph_domain_track(sim->domain, m->Fr, 9, err));
   SPH_TRY(sph_domain_track(sim->domain, m->V0, 1, err));
+  SPH_TRY(ul_mirror_setup(m, err));
   SPH_TRY(rebuild(m, err));
   return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,
                             ul_csph_constrain, m, err);
@@ -393,8 +403,8 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
 static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
   ul_csph *m = sim->method_data;
   size_t n = m->ref.n, ne = m->ref.n_ext;
-  /* over MPI ranks (no images): the owned points, also while a checkpoint
-   * is read (the ghosts' come from their owners) */
+  /* over MPI ranks: the owned points, also while a checkpoint is read
+   * (the ghosts' come from their owners, the images' from their sources) */
   if (sim->domain)
     n = ne = sim->ps->n;
   out[0] = (sph_state_array){"x", m->x, 3 * n};

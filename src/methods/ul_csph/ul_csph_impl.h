@@ -5,6 +5,13 @@
 #include "integrators/integrator_impl.h"
 #include "methods/tl_common_impl.h"
 
+/* an image a rank places: its serial number, source point and slot */
+typedef struct ul_placed {
+  int64_t j;
+  size_t s, k;
+  int far; /* beyond two supports of the owned box: a partial list */
+} ul_placed;
+
 typedef struct ul_csph {
   tl_reference ref; /* X, V, nl, L, w of the current reference x^r */
   double cfl;
@@ -26,6 +33,23 @@ typedef struct ul_csph {
   sph_leapfrog lf;
   int timer_force, timer_update, timer_integration;
   struct sph_sim *sim;
+  /* over MPI ranks with symmetry planes (ul_csph_mirror.c): per particle
+   * its images' serial numbers (-1: none) and reference positions (kimg,
+   * 3 kimg), per point an image's serial number, the placement's work */
+  int kimg;
+  double *imgj, *imgX;
+  int64_t *gj;
+  ul_placed *placed;
 } ul_csph;
+
+/* ul_csph_mirror.c: nothing without tl_images. Set-up (the owned
+ * particles' images, tracked by the domain); after x^r = x, the owned
+ * particles' images' reference positions kept; before a rebuild, x, p, F
+ * into the particle set that migrates; after it, the ghosts moved behind
+ * the images placed in the serial order. */
+sph_status ul_mirror_setup(ul_csph *m, sph_error *err);
+void ul_mirror_store(ul_csph *m);
+void ul_mirror_sync(ul_csph *m);
+sph_status ul_mirror_place(ul_csph *m, sph_error *err);
 
 #endif
