@@ -1,0 +1,191 @@
+/* One rank's share of the particles without the whole set
+ * (sph_scene_build_share, issue 20): every share's particles equal the
+ * whole set's after sph_particles_sort_morton at their storage indices, bit
+ * for bit, and the shares cover the storage indices once (2D and 3D, face
+ * and cell lattices, jitter, several bodies with transforms and initial
+ * velocities, a grid beyond the Morton order's 2^21 clamp). */
+#include "test_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sph/particles.h"
+#include "sph/scene.h"
+
+static sph_scene *load(const char *text) {
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/sph_share_XXXXXX");
+  int fd = mkstemp(path);
+  ck_assert_int_ge(fd, 0);
+  FILE *f = fdopen(fd, "w");
+  fputs(text, f);
+  fclose(f);
+  sph_scene *s = NULL;
+  sph_error err;
+  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
+  unlink(path);
+  ck_assert_msg(st == SPH_OK, "%s", err.message);
+  return s;
+}
+
+static int same(const void *a, const void *b, size_t n) {
+  return memcmp(a, b, n) == 0;
+}
+
+/* the shares of `size` ranks against the sorted whole set */
+static void check_shares(const char *text, double cell, int size) {
+  sph_scene *s = load(text);
+  sph_error err;
+  sph_particles *all = NULL;
+  ck_assert_int_eq(sph_scene_build_particles(s, &all, &err), SPH_OK);
+  ck_assert_int_eq(sph_particles_sort_morton(all, cell, &err), SPH_OK);
+  size_t N = all->n, seen = 0;
+  char *hit = calloc(N, 1);
+  for (int r = 0; r < size; ++r) {
+    sph_particles *ps = NULL;
+    int64_t *gidx = NULL;
+    size_t total = 0;
+    ck_assert_int_eq(
+        sph_scene_build_share(s, cell, r, size, &ps, &gidx, &total, &err),
+        SPH_OK);
+    ck_assert_ptr_nonnull(ps);
+    ck_assert_uint_eq(total, N);
+    ck_assert_uint_eq(ps->n, N * (size_t)(r + 1) / (size_t)size -
+                                 N * (size_t)r / (size_t)size);
+    for (size_t i = 0; i < ps->n; ++i) {
+      int64_t g = gidx[i];
+      ck_assert(g >= 0 && (size_t)g < N && !hit[g]);
+      hit[g] = 1;
+      ++seen;
+      /* a rank keeps the storage indices of its share */
+      ck_assert((size_t)g >= N * (size_t)r / (size_t)size &&
+                (size_t)g < N * (size_t)(r + 1) / (size_t)size);
+      ck_assert_msg(same(ps->field[SPH_FIELD_POSITION0] + 3 * i,
+                         all->field[SPH_FIELD_POSITION0] + 3 * g,
+                         3 * sizeof(double)),
+                    "rank %d particle %zu (storage %lld)", r, i, (long long)g);
+      ck_assert(same(ps->field[SPH_FIELD_VOLUME0] + i,
+                     all->field[SPH_FIELD_VOLUME0] + g, sizeof(double)));
+      ck_assert(same(ps->field[SPH_FIELD_VELOCITY] + 3 * i,
+                     all->field[SPH_FIELD_VELOCITY] + 3 * g,
+                     3 * sizeof(double)));
+      ck_assert_int_eq(ps->id[i], all->id[g]);
+      ck_assert_int_eq(ps->body[i], all->body[g]);
+      ck_assert_uint_eq(ps->flags[i], all->flags[g]);
+    }
+    sph_particles_destroy(ps);
+    free(gidx);
+  }
+  ck_assert_uint_eq(seen, N);
+  free(hit);
+  sph_particles_destroy(all);
+  sph_scene_destroy(s);
+}
+
+#define HEAD3                                                                  \
+  "name: t\n"                                                                  \
+  "dimension: 3\n"                                                             \
+  "method: {name: tl-jst}\n"                                                   \
+  "materials:\n"                                                               \
+  "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "             \
+  "poisson_ratio: 0.3}\n"                                                      \
+  "time: {end: 0.1}\n"                                                         \
+  "bodies:\n"
+
+/* a jittered face lattice (a turned column) beside a jittered cylinder
+ * and a ball of cells, a clamp and a probe */
+static const char *const scene3 =
+    HEAD3 "  - name: column\n"
+          "    material: m\n"
+          "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 6, 0.5]}}\n"
+          "    particles: {count: [6, 31, 5], distribution: jitter, jitter: "
+          "0.3, seed: 7}\n"
+          "    transform: {rotate: {axis: [1, 1, 0], angle: 20}, translate: "
+          "[0.1, 0.2, 0.3]}\n"
+          "    initial_velocity: {rotation: {axis: y, omega: 105, profile: "
+          "\"sin(pi*y/(2*6))\"}}\n"
+          "  - name: can\n"
+          "    material: m\n"
+          "    shape: {cylinder: {center: [3, 0, 0], axis: z, radius: 0.7, "
+          "length: 2}}\n"
+          "    particles: {spacing: 0.17, distribution: jitter, seed: 3}\n"
+          "    initial_velocity: {uniform: [1, 2, 3]}\n"
+          "  - name: ball\n"
+          "    material: m\n"
+          "    shape: {sphere: {center: [-3, 2, 0], radius: 0.8}}\n"
+          "    particles: {spacing: 0.15}\n"
+          "boundaries:\n"
+          "  - {name: base, select: {plane: {axis: y, at: 0.2}}, clamp: "
+          "true}\n"
+          "output:\n"
+          "  probes: [{name: p, at: [3, 0, 1]}]\n";
+
+#define HEAD2                                                                  \
+  "name: t\n"                                                                  \
+  "dimension: 2\n"                                                             \
+  "method: {name: tl-jst}\n"                                                   \
+  "materials:\n"                                                               \
+  "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "             \
+  "poisson_ratio: 0.3}\n"                                                      \
+  "time: {end: 0.1}\n"                                                         \
+  "bodies:\n"
+
+/* a turned jittered plate of cells beside a jittered ring */
+static const char *const scene2 =
+    HEAD2 "  - name: plate\n"
+          "    material: m\n"
+          "    shape: {box: {min: [0, 0], max: [2, 0.4]}}\n"
+          "    particles: {spacing: 0.021, distribution: jitter, jitter: "
+          "0.45, seed: 11}\n"
+          "    transform: {rotate: {angle: 30}, translate: [0.5, -1]}\n"
+          "    initial_velocity: {expression: [\"x*y\", \"-x\", \"0\"]}\n"
+          "  - name: ring\n"
+          "    material: m\n"
+          "    shape: {ring: {center: [-1, 1], inner_radius: 0.2, "
+          "outer_radius: 0.35}}\n"
+          "    particles: {spacing: 0.02, distribution: jitter, seed: 5}\n"
+          "boundaries:\n"
+          "  - {name: left, select: {box: {min: [-2, 0.5], max: [-0.5, 1]}}, "
+          "clamp: true}\n";
+
+/* a bar whose cells pass the 2^21 clamp of the Morton order along x */
+static const char *const bar2 =
+    HEAD2 "  - name: bar\n"
+          "    material: m\n"
+          "    shape: {box: {min: [0, 0], max: [1, 1e-7]}}\n"
+          "    particles: {count: [3000, 2], distribution: jitter, seed: 2}\n";
+
+START_TEST(share_3d) {
+  for (int size = 1; size <= 4; ++size)
+    check_shares(scene3, 0.41, size);
+  check_shares(scene3, 0.07, 3); /* fewer particles a cell */
+}
+END_TEST
+
+START_TEST(share_2d) {
+  for (int size = 1; size <= 3; ++size)
+    check_shares(scene2, 0.052, size);
+}
+END_TEST
+
+START_TEST(share_clamp) {
+  /* 3.0e6 cells across the bar: its last 900 particles share the last
+   * cell, in creation order */
+  check_shares(bar2, 1.0 / 3.0e6, 2);
+}
+END_TEST
+
+static Suite *suite(void) {
+  Suite *s = suite_create("share");
+  TCase *t = tcase_create("share");
+  tcase_set_timeout(t, 300);
+  tcase_add_test(t, share_3d);
+  tcase_add_test(t, share_2d);
+  tcase_add_test(t, share_clamp);
+  suite_add_tcase(s, t);
+  return s;
+}
+
+int main(void) { return sph_test_run(suite()); }
