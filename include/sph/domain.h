@@ -40,7 +40,8 @@ sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
 void sph_domain_destroy(sph_domain *d);
 /* sph_domain_create without the whole set: each rank passes its share of
  * the N particles (*ps, any subset as sph_scene_build_share makes them,
- * with their storage indices gidx); the owned sets, storage indices,
+ * with their storage indices gidx; *ps becomes the owned set, NULL after
+ * an error past the partition); the owned sets, storage indices,
  * ghosts and halo are sph_domain_create's. Collective. */
 sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
                                    const int64_t *gidx, size_t N,
@@ -54,6 +55,9 @@ sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
 /* sph_domain_agree over every rank before a domain exists (st for one
  * rank). */
 sph_status sph_domain_world_agree(sph_status st, sph_error *err);
+/* The same, the error of the failing rank with the lowest key (then the
+ * lowest rank). */
+sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err);
 /* The ranks on this rank's node (sharing its memory; 1 without MPI). */
 int sph_domain_node_size(void);
 

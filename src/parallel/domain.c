@@ -958,6 +958,11 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
         &world, at ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "ghosts"), err);
     free(at);
   }
+  /* the share is in the records now */
+  if (st == SPH_OK) {
+    sph_particles_destroy(in);
+    *ps = NULL;
+  }
   if (st == SPH_OK)
     st = send_recs(send, count, type, &own, &d->n, err);
   free(send);
@@ -1015,7 +1020,6 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
     sph_domain_destroy(d);
     return st;
   }
-  sph_particles_destroy(in);
   *ps = mine;
   *out = d;
   return SPH_OK;
@@ -1081,10 +1085,28 @@ sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
 }
 
 sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
+  return sph_domain_world_first(st, INT64_MAX, err);
+}
+
+sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err) {
   if (world_size < 2)
     return st;
-  sph_domain world = {.rank = world_rank, .size = world_size};
-  return sph_domain_agree(&world, st, err);
+  /* the failing rank of the lowest key, then of the lowest rank */
+  int64_t mine[2] = {st != SPH_OK ? key : INT64_MAX,
+                     st != SPH_OK ? world_rank : world_size},
+          low[2];
+  MPI_Allreduce(mine, low, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+  if (mine[0] != low[0])
+    mine[1] = world_size;
+  MPI_Allreduce(mine + 1, low + 1, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+  if (low[1] == world_size)
+    return SPH_OK;
+  sph_error e;
+  if (low[1] == world_rank)
+    e = *err;
+  MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, (int)low[1], MPI_COMM_WORLD);
+  *err = e;
+  return e.code != SPH_OK ? e.code : SPH_ERR_IO;
 }
 
 int sph_domain_node_size(void) {
@@ -1301,6 +1323,11 @@ sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
 
 sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
   (void)err;
+  return st;
+}
+
+sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err) {
+  (void)key, (void)err;
   return st;
 }
 

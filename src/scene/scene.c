@@ -1592,43 +1592,56 @@ static sph_status body_error(const sph_scene *s, size_t b, sph_status st,
                       key, "%s", msg);
 }
 
-static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
+/* bodies A and B overlap: particles at Xa and Xb closer than dp / 2 */
+static sph_status overlap_error(const sph_scene *s, int32_t A, int32_t B,
+                                const double Xa[3], const double Xb[3],
                                 sph_error *err) {
-  if (s->nbodies < 2)
-    return SPH_OK;
+  const sph_body *later = &s->bodies[A > B ? A : B];
+  const sph_body *first = &s->bodies[A > B ? B : A];
+  char key[32];
+  snprintf(key, sizeof key, "bodies[%d]", (int)(later - s->bodies));
+  return sph_error_at(err, SPH_ERR_GEOMETRY, s->path, later->line, later->col,
+                      key,
+                      "body '%s' overlaps body '%s' (particles %.3g m "
+                      "apart)",
+                      later->name, first->name,
+                      sqrt(pow(Xa[0] - Xb[0], 2) + pow(Xa[1] - Xb[1], 2) +
+                           pow(Xa[2] - Xb[2], 2)));
+}
+
+/* the first of the n points X (bodies, in creation order) that `check`
+ * marks with a point of another body closer than dp / 2, and the first
+ * such point: as an error, *first its index (n: none) */
+static sph_status find_overlap(const sph_scene *s, const double *X,
+                               const int32_t *body, const char *check, size_t n,
+                               size_t *first, sph_error *err) {
+  *first = n;
   sph_neighbors *nl;
   SPH_TRY(sph_neighbors_create(&nl, err));
-  sph_status st = sph_neighbors_build(
-      nl, ps->field[SPH_FIELD_POSITION0], ps->n, s->dimension,
-      0.5 * sph_scene_min_spacing(s), NULL, SPH_PAIRS_ALL, err);
-  for (size_t a = 0; st == SPH_OK && a < ps->n; ++a)
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+  sph_status st = sph_neighbors_build(nl, X, n, s->dimension,
+                                      0.5 * sph_scene_min_spacing(s), NULL,
+                                      SPH_PAIRS_ALL, err);
+  for (size_t a = 0; st == SPH_OK && a < n; ++a)
+    for (size_t k = nl->offset[a];
+         (!check || check[a]) && k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      if (ps->body[b] == ps->body[a])
+      if (body[b] == body[a])
         continue;
-      const sph_body *A = &s->bodies[ps->body[a]], *B = &s->bodies[ps->body[b]];
-      const sph_body *later = ps->body[a] > ps->body[b] ? A : B;
-      const sph_body *first = later == A ? B : A;
-      char key[32];
-      snprintf(key, sizeof key, "bodies[%d]", (int)(later - s->bodies));
-      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, later->line, later->col,
-                        key,
-                        "body '%s' overlaps body '%s' (particles %.3g m "
-                        "apart)",
-                        later->name, first->name,
-                        sqrt(pow(ps->field[SPH_FIELD_POSITION0][3 * a] -
-                                     ps->field[SPH_FIELD_POSITION0][3 * b],
-                                 2) +
-                             pow(ps->field[SPH_FIELD_POSITION0][3 * a + 1] -
-                                     ps->field[SPH_FIELD_POSITION0][3 * b + 1],
-                                 2) +
-                             pow(ps->field[SPH_FIELD_POSITION0][3 * a + 2] -
-                                     ps->field[SPH_FIELD_POSITION0][3 * b + 2],
-                                 2)));
+      *first = a;
+      st = overlap_error(s, body[a], body[b], X + 3 * a, X + 3 * b, err);
       break;
     }
   sph_neighbors_destroy(nl);
   return st;
+}
+
+static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
+                                sph_error *err) {
+  if (s->nbodies < 2)
+    return SPH_OK;
+  size_t first;
+  return find_overlap(s, ps->field[SPH_FIELD_POSITION0], ps->body, NULL, ps->n,
+                      &first, err);
 }
 
 sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
@@ -1703,7 +1716,59 @@ typedef struct share_pass {
   int64_t first, last; /* storage indices kept: [first, last) */
   sph_particles *ps;
   int64_t *gidx;
+  /* several bodies: the share's particles and those of the cells next to
+   * its cells (the overlap check's neighbours), in creation order */
+  char *mine; /* per cell: holds a particle of the share */
+  double *nx;
+  int32_t *nbody;
+  int64_t *nid;
+  char *nin; /* in the share */
+  size_t nn, ncap;
 } share_pass;
+
+/* whether a cell next to q (or q) holds a particle of the share */
+static int near_share(const share_pass *p, const uint32_t q[3]) {
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k) {
+        long c[3] = {(long)q[0] + i, (long)q[1] + j, (long)q[2] + k};
+        int in = 1;
+        for (int e = 0; e < 3; ++e)
+          in &= c[e] >= 0 && c[e] < (long)p->nc[e];
+        if (in && p->mine[((size_t)c[2] * p->nc[1] + (size_t)c[1]) * p->nc[0] +
+                          (size_t)c[0]])
+          return 1;
+      }
+  return 0;
+}
+
+/* a point of the overlap check */
+static sph_status keep_near(share_pass *p, const double X[3], int64_t id,
+                            int in, sph_error *err) {
+  if (p->nn == p->ncap) {
+    size_t c = p->ncap ? 2 * p->ncap : 1024;
+    double *x = realloc(p->nx, 3 * c * sizeof *x);
+    if (x)
+      p->nx = x;
+    int32_t *b = realloc(p->nbody, c * sizeof *b);
+    if (b)
+      p->nbody = b;
+    int64_t *i = realloc(p->nid, c * sizeof *i);
+    if (i)
+      p->nid = i;
+    char *n = realloc(p->nin, c);
+    if (n)
+      p->nin = n;
+    if (!x || !b || !i || !n)
+      return sph_error_set(err, SPH_ERR_NOMEM, "overlap check");
+    p->ncap = c;
+  }
+  memcpy(p->nx + 3 * p->nn, X, 3 * sizeof *X);
+  p->nbody[p->nn] = (int32_t)p->b;
+  p->nid[p->nn] = id;
+  p->nin[p->nn++] = (char)in;
+  return SPH_OK;
+}
 
 typedef struct share_cell {
   uint64_t key;
@@ -1739,7 +1804,10 @@ static sph_status share_point(void *ctx, const double Xb[3], double volume,
   }
   /* particles of one cell in creation order: the sort's tie-break */
   int64_t g = p->grid[cell]++;
-  if (g < p->first || g >= p->last)
+  int in = g >= p->first && g < p->last;
+  if (p->mine && (in || near_share(p, q)))
+    SPH_TRY(keep_near(p, X, id, in, err));
+  if (!in)
     return SPH_OK;
   sph_particles *ps = p->ps;
   particle_state(s, p->b, Xb, X, v, &flags, NULL);
@@ -1787,6 +1855,8 @@ static sph_status share_starts(share_pass *p, size_t cells, sph_error *err) {
   for (size_t j = 0; j < m; ++j) {
     int64_t count = p->grid[occ[j].cell];
     p->grid[occ[j].cell] = start;
+    if (p->mine)
+      p->mine[occ[j].cell] = start < p->last && start + count > p->first;
     start += count;
   }
   free(occ);
@@ -1795,10 +1865,12 @@ static sph_status share_starts(share_pass *p, size_t cells, sph_error *err) {
 
 sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
                                  int size, sph_particles **out, int64_t **gidx,
-                                 size_t *total, sph_error *err) {
+                                 size_t *total, int64_t *overlap,
+                                 sph_error *err) {
   *out = NULL;
   *gidx = NULL;
   *total = 0;
+  *overlap = INT64_MAX;
   share_pass p = {.s = s,
                   .cell = cell,
                   .lo = {INFINITY, INFINITY, INFINITY},
@@ -1810,32 +1882,46 @@ sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
   size_t N = (size_t)p.id;
   if (st == SPH_OK)
     st = checks_first(&p.c, err);
-  if (st == SPH_OK)
-    st = checks_rest(s, &p.c, err);
+  /* the later checks' error comes after the overlap check's */
+  sph_error later;
+  sph_status rest = st == SPH_OK ? checks_rest(s, &p.c, &later) : SPH_OK;
   checks_destroy(&p.c);
+  int several = s->nbodies > 1;
+  if (st == SPH_OK && rest != SPH_OK && !several)
+    *err = later, st = rest;
   if (st != SPH_OK)
     return st;
   /* the cell grid of the Morton order; a sparse one (far apart bodies)
-   * larger than 2 cells a particle and 2^22 cells: the whole set instead */
+   * larger than 2 cells a particle and 2^22 cells, or for the overlap check
+   * cells clamped or smaller than its dp / 2: the whole set instead */
   double cells = 1.0;
+  int clamped = 0;
   for (int c = 0; c < 3; ++c) {
-    p.nc[c] = (size_t)fmin(floor((p.hi[c] - p.lo[c]) / cell), 2097151.0) + 1;
+    double q = floor((p.hi[c] - p.lo[c]) / cell);
+    clamped |= q > 2097151.0;
+    p.nc[c] = (size_t)fmin(q, 2097151.0) + 1;
     cells *= (double)p.nc[c];
   }
-  if (!(cell > 0.0) || cells > fmax(2.0 * (double)N, 4194304.0))
+  if (!(cell > 0.0) || cells > fmax(2.0 * (double)N, 4194304.0) ||
+      (several && (clamped || 0.5 * sph_scene_min_spacing(s) > cell)))
     return SPH_OK;
   p.grid = calloc((size_t)cells, sizeof *p.grid);
-  if (!p.grid)
+  if (several)
+    p.mine = calloc((size_t)cells, 1);
+  if (!p.grid || (several && !p.mine)) {
+    free(p.grid);
+    free(p.mine);
     return sph_error_set(err, SPH_ERR_NOMEM, "particle order (%.3g cells)",
                          cells);
+  }
   /* pass 2: particles per cell; pass 3: storage indices, keeping the
    * share [rank N / size, (rank + 1) N / size) */
-  st = share_visit(&p, 2, err);
-  if (st == SPH_OK)
-    st = share_starts(&p, (size_t)cells, err);
   p.first = (int64_t)(N * (size_t)rank / (size_t)size);
   p.last = (int64_t)(N * ((size_t)rank + 1) / (size_t)size);
   size_t m = (size_t)(p.last - p.first);
+  st = share_visit(&p, 2, err);
+  if (st == SPH_OK)
+    st = share_starts(&p, (size_t)cells, err);
   if (st == SPH_OK)
     st = sph_particles_create(&p.ps, m, s->dimension, err);
   if (st == SPH_OK)
@@ -1845,6 +1931,21 @@ sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
   if (st == SPH_OK)
     st = share_visit(&p, 3, err);
   free(p.grid);
+  free(p.mine);
+  /* bodies that overlap: the share's first particle with a neighbour of
+   * another body closer than dp / 2 (its neighbours are in the share or
+   * the cells next to its cells) */
+  size_t bad = p.nn;
+  if (st == SPH_OK && several)
+    st = find_overlap(s, p.nx, p.nbody, p.nin, p.nn, &bad, err);
+  if (bad < p.nn)
+    *overlap = p.nid[bad];
+  if (st == SPH_OK && rest != SPH_OK)
+    *err = later, st = rest;
+  free(p.nx);
+  free(p.nbody);
+  free(p.nid);
+  free(p.nin);
   if (st != SPH_OK) {
     sph_particles_destroy(p.ps);
     free(p.gidx);

@@ -182,11 +182,10 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
 /* Whether each rank can build its own share of the particles without the
  * whole set (sph_scene_build_share): a fixed domain without symmetry planes
  * (their mirror ghosts and the dynamic domain's cut tree come from the
- * whole set), one body (the overlap check of several reads the whole set)
- * of lattice or jitter points (a relaxation moves the whole body). */
+ * whole set), bodies of lattice or jitter points (a relaxation moves the
+ * whole body). */
 static int per_rank_setup(const sph_scene *s, const sph_method_ops *method) {
-  if (sph_domain_world_size() < 2 || method->distributed != 1 ||
-      s->nbodies != 1)
+  if (sph_domain_world_size() < 2 || method->distributed != 1)
     return 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
@@ -248,12 +247,15 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   if (st == SPH_OK)
     st = check_memory(scene, sim->kernel.support, sim->dp, err);
   /* over MPI ranks: this rank's share of the particles, in the order below */
-  int64_t *gidx = NULL;
+  int64_t *gidx = NULL, first = INT64_MAX;
   size_t N = 0;
   if (st == SPH_OK && per_rank_setup(scene, method))
     st = sph_scene_build_share(scene, sim->kernel.support,
                                sph_domain_world_rank(), sph_domain_world_size(),
-                               &sim->ps, &gidx, &N, err);
+                               &sim->ps, &gidx, &N, &first, err);
+  /* a rank's error about its particles: the one of the lowest creation
+   * index, the whole set's */
+  st = sph_domain_world_first(st, first, err);
   if (st == SPH_OK && !sim->ps)
     st = sph_scene_build_particles(scene, &sim->ps, err);
   /* neighbours near in memory: cells of one kernel support in Morton order */

@@ -5,7 +5,8 @@
  * indices, ghosts (positions, volumes, bodies, ids, in the same order) and
  * halo plan, and rank 0's whole set (sph_domain_whole_create) the sorted
  * whole set. 3D face lattice with jitter (a turned column), 2D cells with
- * jitter. Run under mpirun (ctest: 2, 3 and 4 ranks). */
+ * jitter, two 3D bodies (a block and a punch). Run under mpirun (ctest: 2, 3
+ * and 4 ranks). */
 #include "parallel/domain_impl.h"
 
 #include <check.h>
@@ -54,13 +55,13 @@ static int differences(const char *text, double support) {
   sph_scene *s = load(text);
   sph_error err;
   sph_particles *whole = NULL, *share = NULL;
-  int64_t *gidx = NULL;
+  int64_t *gidx = NULL, first;
   size_t N = 0;
   ck_assert_int_eq(sph_scene_build_particles(s, &whole, &err), SPH_OK);
   ck_assert_int_eq(sph_particles_sort_morton(whole, support, &err), SPH_OK);
   ck_assert_int_eq(sph_scene_build_share(s, support, sph_domain_world_rank(),
                                          sph_domain_world_size(), &share, &gidx,
-                                         &N, &err),
+                                         &N, &first, &err),
                    SPH_OK);
   ck_assert_ptr_nonnull(share);
   sph_particles *sorted = NULL; /* rank 0's whole set to compare */
@@ -150,6 +151,22 @@ START_TEST(ring_2d) {
 }
 END_TEST
 
+START_TEST(bodies_3d) {
+  const char *scene =
+      HEAD(3) "  - name: block\n"
+              "    material: m\n"
+              "    shape: {box: {min: [-1, -0.4, -1], max: [1, 0, 1]}}\n"
+              "    particles: {count: [21, 5, 21]}\n"
+              "  - name: punch\n"
+              "    material: m\n"
+              "    shape: {cylinder: {center: [0, 0.05, 0], axis: y, radius: "
+              "0.3, length: 0.5}}\n"
+              "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
+              "    initial_velocity: {uniform: [0, -1, 0]}\n";
+  ck_assert_int_eq(differences(scene, 0.26), 0);
+}
+END_TEST
+
 int main(int argc, char **argv) {
   sph_error err;
   if (sph_domain_init(&argc, &argv, &err) != SPH_OK)
@@ -159,6 +176,7 @@ int main(int argc, char **argv) {
   tcase_set_timeout(t, 300);
   tcase_add_test(t, column_3d);
   tcase_add_test(t, ring_2d);
+  tcase_add_test(t, bodies_3d);
   suite_add_tcase(s, t);
   SRunner *sr = srunner_create(s);
   srunner_set_fork_status(sr, CK_NOFORK); /* one MPI process a rank */
