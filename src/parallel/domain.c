@@ -720,6 +720,7 @@ typedef struct share_rec {
   int64_t id, g; /* particle id, storage index */
   int32_t body, owner;
   uint32_t flags;
+  int32_t edge; /* an owned one within another rank's widened box */
 } share_rec;
 
 static int cmp_rec_storage(const void *pa, const void *pb) {
@@ -778,12 +779,16 @@ static sph_status send_recs(const share_rec *send, const int *count,
 
 /* the ghosts among the owned records own (storage order) and the
  * candidates cand (others' particles in the owned box widened by
- * `support`): as find_ghosts, over the same points in the same order;
- * *ghost (malloc'd) by owner and storage index */
+ * `support`): as find_ghosts, whose pairs of an owned particle and another
+ * rank's are those among the candidates and the owned particles within
+ * their ranks' widened boxes (edge); *ghost (malloc'd) by owner and
+ * storage index */
 static sph_status share_ghosts(const share_rec *own, size_t n, share_rec *cand,
                                size_t nc, int dim, double support,
                                share_rec **ghost, size_t *ng, sph_error *err) {
-  size_t m = n + nc;
+  size_t m = nc;
+  for (size_t a = 0; a < n; ++a)
+    m += own[a].edge != 0;
   share_rec *all = malloc((m ? m : 1) * sizeof *all);
   double *cx = malloc(3 * (m ? m : 1) * sizeof *cx);
   int32_t *cb = malloc((m ? m : 1) * sizeof *cb);
@@ -793,8 +798,10 @@ static sph_status share_ghosts(const share_rec *own, size_t n, share_rec *cand,
                       ? sph_neighbors_create(&nl, err)
                       : sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
   if (st == SPH_OK) {
-    memcpy(all, own, n * sizeof *all);
-    memcpy(all + n, cand, nc * sizeof *all);
+    memcpy(all, cand, nc * sizeof *all);
+    for (size_t a = 0, j = nc; a < n; ++a)
+      if (own[a].edge)
+        all[j++] = own[a];
     qsort(all, m, sizeof *all, cmp_rec_storage);
     for (size_t j = 0; j < m; ++j) {
       memcpy(cx + 3 * j, all[j].X, 3 * sizeof *cx);
@@ -856,7 +863,7 @@ static int in_box(const double *box, const double X[3], int dim, double w) {
 
 /* each rank's owned records to the ranks whose owned box, widened by
  * `support`, holds them (collective) */
-static sph_status share_candidates(const share_rec *own, size_t n, int dim,
+static sph_status share_candidates(share_rec *own, size_t n, int dim,
                                    double support, MPI_Datatype type,
                                    share_rec **cand, size_t *nc,
                                    sph_error *err) {
@@ -881,7 +888,8 @@ static sph_status share_candidates(const share_rec *own, size_t n, int dim,
   size_t total = 0;
   for (int q = 0; q < R; ++q)
     for (size_t a = 0; q != world_rank && a < n; ++a)
-      count[q] += in_box(boxes + 6 * q, own[a].X, dim, support);
+      if (in_box(boxes + 6 * q, own[a].X, dim, support))
+        count[q]++, own[a].edge = 1;
   for (int q = 0; q < R; ++q)
     total += (size_t)count[q];
   share_rec *send = malloc((total ? total : 1) * sizeof *send);
@@ -953,6 +961,7 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
       r->g = gidx[i];
       r->body = in->body[i];
       r->flags = in->flags[i];
+      r->edge = 0;
     }
     st = sph_domain_agree(
         &world, at ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "ghosts"), err);
