@@ -14,26 +14,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "sph/scene.h"
-
-static sph_scene *load(const char *text) {
-  char path[64];
-  snprintf(path, sizeof path, "/tmp/sph_share_%d_XXXXXX",
-           sph_domain_world_rank());
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  FILE *f = fdopen(fd, "w");
-  fputs(text, f);
-  fclose(f);
-  sph_scene *s = NULL;
-  sph_error err;
-  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
-  unlink(path);
-  ck_assert_msg(st == SPH_OK, "%s", err.message);
-  return s;
-}
+#include "test_scene_util.h"
 
 #define SAME(a, b, n) (memcmp((a), (b), (n) * sizeof *(a)) == 0)
 
@@ -52,7 +35,7 @@ static int same_set(const sph_particles *a, const sph_particles *b) {
 
 /* ranks where the two set-ups differ */
 static int differences(const char *text, double support) {
-  sph_scene *s = load(text);
+  sph_scene *s = sph_test_scene_text(text);
   sph_error err;
   sph_particles *whole = NULL, *share = NULL;
   int64_t *gidx = NULL, first;
@@ -112,57 +95,47 @@ static int differences(const char *text, double support) {
   return all;
 }
 
-#define HEAD(dim)                                                              \
-  "name: t\n"                                                                  \
-  "dimension: " #dim "\n"                                                      \
-  "method: {name: tl-jst}\n"                                                   \
-  "materials:\n"                                                               \
-  "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "             \
-  "poisson_ratio: 0.3}\n"                                                      \
-  "time: {end: 0.1}\n"                                                         \
-  "bodies:\n"
-
 START_TEST(column_3d) {
-  const char *scene =
-      HEAD(3) "  - name: column\n"
-              "    material: m\n"
-              "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 6, 0.5]}}\n"
-              "    particles: {count: [7, 37, 6], distribution: jitter, "
-              "jitter: 0.3, seed: 7}\n"
-              "    transform: {rotate: {axis: [1, 1, 0], angle: 20}}\n"
-              "    initial_velocity: {rotation: {axis: y, omega: 105}}\n"
-              "boundaries:\n"
-              "  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: "
-              "true}\n";
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      3) "  - name: column\n"
+         "    material: m\n"
+         "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 6, 0.5]}}\n"
+         "    particles: {count: [7, 37, 6], distribution: jitter, "
+         "jitter: 0.3, seed: 7}\n"
+         "    transform: {rotate: {axis: [1, 1, 0], angle: 20}}\n"
+         "    initial_velocity: {rotation: {axis: y, omega: 105}}\n"
+         "boundaries:\n"
+         "  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: "
+         "true}\n";
   /* the support of h = 1.3 dp, wendland: 2.6 dp */
   ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0), 0);
 }
 END_TEST
 
 START_TEST(ring_2d) {
-  const char *scene =
-      HEAD(2) "  - name: ring\n"
-              "    material: m\n"
-              "    shape: {ring: {center: [-1, 1], inner_radius: 0.2, "
-              "outer_radius: 0.35}}\n"
-              "    particles: {spacing: 0.01, distribution: jitter, seed: 5}\n"
-              "    initial_velocity: {uniform: [1, 0, 0]}\n";
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      2) "  - name: ring\n"
+         "    material: m\n"
+         "    shape: {ring: {center: [-1, 1], inner_radius: 0.2, "
+         "outer_radius: 0.35}}\n"
+         "    particles: {spacing: 0.01, distribution: jitter, seed: 5}\n"
+         "    initial_velocity: {uniform: [1, 0, 0]}\n";
   ck_assert_int_eq(differences(scene, 0.026), 0);
 }
 END_TEST
 
 START_TEST(bodies_3d) {
-  const char *scene =
-      HEAD(3) "  - name: block\n"
-              "    material: m\n"
-              "    shape: {box: {min: [-1, -0.4, -1], max: [1, 0, 1]}}\n"
-              "    particles: {count: [21, 5, 21]}\n"
-              "  - name: punch\n"
-              "    material: m\n"
-              "    shape: {cylinder: {center: [0, 0.05, 0], axis: y, radius: "
-              "0.3, length: 0.5}}\n"
-              "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
-              "    initial_velocity: {uniform: [0, -1, 0]}\n";
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      3) "  - name: block\n"
+         "    material: m\n"
+         "    shape: {box: {min: [-1, -0.4, -1], max: [1, 0, 1]}}\n"
+         "    particles: {count: [21, 5, 21]}\n"
+         "  - name: punch\n"
+         "    material: m\n"
+         "    shape: {cylinder: {center: [0, 0.05, 0], axis: y, radius: "
+         "0.3, length: 0.5}}\n"
+         "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
+         "    initial_velocity: {uniform: [0, -1, 0]}\n";
   ck_assert_int_eq(differences(scene, 0.26), 0);
 }
 END_TEST

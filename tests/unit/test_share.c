@@ -11,27 +11,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "sph/geometry.h"
 #include "sph/particles.h"
 #include "sph/scene.h"
-
-static sph_scene *load(const char *text) {
-  char path[64];
-  snprintf(path, sizeof path, "/tmp/sph_share_XXXXXX");
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  FILE *f = fdopen(fd, "w");
-  fputs(text, f);
-  fclose(f);
-  sph_scene *s = NULL;
-  sph_error err;
-  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
-  unlink(path);
-  ck_assert_msg(st == SPH_OK, "%s", err.message);
-  return s;
-}
+#include "test_scene_util.h"
 
 static int same(const void *a, const void *b, size_t n) {
   return memcmp(a, b, n) == 0;
@@ -39,7 +23,7 @@ static int same(const void *a, const void *b, size_t n) {
 
 /* the shares of `size` ranks against the sorted whole set */
 static void check_shares(const char *text, double cell, int size) {
-  sph_scene *s = load(text);
+  sph_scene *s = sph_test_scene_text(text);
   sph_error err;
   sph_particles *all = NULL;
   ck_assert_int_eq(sph_scene_build_particles(s, &all, &err), SPH_OK);
@@ -89,78 +73,58 @@ static void check_shares(const char *text, double cell, int size) {
   sph_scene_destroy(s);
 }
 
-#define HEAD3                                                                  \
-  "name: t\n"                                                                  \
-  "dimension: 3\n"                                                             \
-  "method: {name: tl-jst}\n"                                                   \
-  "materials:\n"                                                               \
-  "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "             \
-  "poisson_ratio: 0.3}\n"                                                      \
-  "time: {end: 0.1}\n"                                                         \
-  "bodies:\n"
-
 /* a jittered face lattice (a turned column) beside a jittered cylinder
  * and a ball of cells, a clamp and a probe */
-static const char *const scene3 =
-    HEAD3 "  - name: column\n"
-          "    material: m\n"
-          "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 6, 0.5]}}\n"
-          "    particles: {count: [6, 31, 5], distribution: jitter, jitter: "
-          "0.3, seed: 7}\n"
-          "    transform: {rotate: {axis: [1, 1, 0], angle: 20}, translate: "
-          "[0.1, 0.2, 0.3]}\n"
-          "    initial_velocity: {rotation: {axis: y, omega: 105, profile: "
-          "\"sin(pi*y/(2*6))\"}}\n"
-          "  - name: can\n"
-          "    material: m\n"
-          "    shape: {cylinder: {center: [3, 0, 0], axis: z, radius: 0.7, "
-          "length: 2}}\n"
-          "    particles: {spacing: 0.17, distribution: jitter, seed: 3}\n"
-          "    initial_velocity: {uniform: [1, 2, 3]}\n"
-          "  - name: ball\n"
-          "    material: m\n"
-          "    shape: {sphere: {center: [-3, 2, 0], radius: 0.8}}\n"
-          "    particles: {spacing: 0.15}\n"
-          "boundaries:\n"
-          "  - {name: base, select: {plane: {axis: y, at: 0.2}}, clamp: "
-          "true}\n"
-          "output:\n"
-          "  probes: [{name: p, at: [3, 0, 1]}]\n";
-
-#define HEAD2                                                                  \
-  "name: t\n"                                                                  \
-  "dimension: 2\n"                                                             \
-  "method: {name: tl-jst}\n"                                                   \
-  "materials:\n"                                                               \
-  "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "             \
-  "poisson_ratio: 0.3}\n"                                                      \
-  "time: {end: 0.1}\n"                                                         \
-  "bodies:\n"
+static const char *const scene3 = SPH_TEST_SCENE_HEAD(
+    3) "  - name: column\n"
+       "    material: m\n"
+       "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 6, 0.5]}}\n"
+       "    particles: {count: [6, 31, 5], distribution: jitter, jitter: "
+       "0.3, seed: 7}\n"
+       "    transform: {rotate: {axis: [1, 1, 0], angle: 20}, translate: "
+       "[0.1, 0.2, 0.3]}\n"
+       "    initial_velocity: {rotation: {axis: y, omega: 105, profile: "
+       "\"sin(pi*y/(2*6))\"}}\n"
+       "  - name: can\n"
+       "    material: m\n"
+       "    shape: {cylinder: {center: [3, 0, 0], axis: z, radius: 0.7, "
+       "length: 2}}\n"
+       "    particles: {spacing: 0.17, distribution: jitter, seed: 3}\n"
+       "    initial_velocity: {uniform: [1, 2, 3]}\n"
+       "  - name: ball\n"
+       "    material: m\n"
+       "    shape: {sphere: {center: [-3, 2, 0], radius: 0.8}}\n"
+       "    particles: {spacing: 0.15}\n"
+       "boundaries:\n"
+       "  - {name: base, select: {plane: {axis: y, at: 0.2}}, clamp: "
+       "true}\n"
+       "output:\n"
+       "  probes: [{name: p, at: [3, 0, 1]}]\n";
 
 /* a turned jittered plate of cells beside a jittered ring */
-static const char *const scene2 =
-    HEAD2 "  - name: plate\n"
-          "    material: m\n"
-          "    shape: {box: {min: [0, 0], max: [2, 0.4]}}\n"
-          "    particles: {spacing: 0.021, distribution: jitter, jitter: "
-          "0.45, seed: 11}\n"
-          "    transform: {rotate: {angle: 30}, translate: [0.5, -1]}\n"
-          "    initial_velocity: {expression: [\"x*y\", \"-x\", \"0\"]}\n"
-          "  - name: ring\n"
-          "    material: m\n"
-          "    shape: {ring: {center: [-1, 1], inner_radius: 0.2, "
-          "outer_radius: 0.35}}\n"
-          "    particles: {spacing: 0.02, distribution: jitter, seed: 5}\n"
-          "boundaries:\n"
-          "  - {name: left, select: {box: {min: [-2, 0.5], max: [-0.5, 1]}}, "
-          "clamp: true}\n";
+static const char *const scene2 = SPH_TEST_SCENE_HEAD(
+    2) "  - name: plate\n"
+       "    material: m\n"
+       "    shape: {box: {min: [0, 0], max: [2, 0.4]}}\n"
+       "    particles: {spacing: 0.021, distribution: jitter, jitter: "
+       "0.45, seed: 11}\n"
+       "    transform: {rotate: {angle: 30}, translate: [0.5, -1]}\n"
+       "    initial_velocity: {expression: [\"x*y\", \"-x\", \"0\"]}\n"
+       "  - name: ring\n"
+       "    material: m\n"
+       "    shape: {ring: {center: [-1, 1], inner_radius: 0.2, "
+       "outer_radius: 0.35}}\n"
+       "    particles: {spacing: 0.02, distribution: jitter, seed: 5}\n"
+       "boundaries:\n"
+       "  - {name: left, select: {box: {min: [-2, 0.5], max: [-0.5, 1]}}, "
+       "clamp: true}\n";
 
 /* a bar whose cells pass the 2^21 clamp of the Morton order along x */
-static const char *const bar2 =
-    HEAD2 "  - name: bar\n"
-          "    material: m\n"
-          "    shape: {box: {min: [0, 0], max: [1, 1e-7]}}\n"
-          "    particles: {count: [3000, 2], distribution: jitter, seed: 2}\n";
+static const char *const bar2 = SPH_TEST_SCENE_HEAD(
+    2) "  - name: bar\n"
+       "    material: m\n"
+       "    shape: {box: {min: [0, 0], max: [1, 1e-7]}}\n"
+       "    particles: {count: [3000, 2], distribution: jitter, seed: 2}\n";
 
 /* the creation index of the first particle with a neighbour of another
  * body closer than dp / 2, by brute force */
@@ -202,7 +166,7 @@ static int64_t first_overlap(const sph_scene *s) {
 /* bodies that overlap: the shares' error of the lowest creation index is
  * the whole set's, message and all */
 static void check_overlap(const char *text, double cell, int size) {
-  sph_scene *s = load(text);
+  sph_scene *s = sph_test_scene_text(text);
   sph_error whole, err, best;
   sph_particles *all = NULL;
   ck_assert_int_eq(sph_scene_build_particles(s, &all, &whole),
@@ -226,22 +190,22 @@ static void check_overlap(const char *text, double cell, int size) {
 }
 
 /* a turned box resting into a cylinder of cells; a third body apart */
-static const char *const overlap3 =
-    HEAD3 "  - name: far\n"
-          "    material: m\n"
-          "    shape: {sphere: {center: [-3, 0, 0], radius: 0.5}}\n"
-          "    particles: {spacing: 0.1}\n"
-          "  - name: can\n"
-          "    material: m\n"
-          "    shape: {cylinder: {center: [0, 0, 0], axis: y, radius: 0.7, "
-          "length: 1}}\n"
-          "    particles: {spacing: 0.1, distribution: jitter, seed: 3}\n"
-          "  - name: lid\n"
-          "    material: m\n"
-          "    shape: {box: {min: [-0.5, 0.97, -0.5], max: [0.5, 1.3, 0.5]}}\n"
-          "    particles: {count: [11, 4, 11], distribution: jitter, seed: "
-          "4}\n"
-          "    transform: {rotate: {axis: [1, 0, 1], angle: 3}}\n";
+static const char *const overlap3 = SPH_TEST_SCENE_HEAD(
+    3) "  - name: far\n"
+       "    material: m\n"
+       "    shape: {sphere: {center: [-3, 0, 0], radius: 0.5}}\n"
+       "    particles: {spacing: 0.1}\n"
+       "  - name: can\n"
+       "    material: m\n"
+       "    shape: {cylinder: {center: [0, 0, 0], axis: y, radius: 0.7, "
+       "length: 1}}\n"
+       "    particles: {spacing: 0.1, distribution: jitter, seed: 3}\n"
+       "  - name: lid\n"
+       "    material: m\n"
+       "    shape: {box: {min: [-0.5, 0.97, -0.5], max: [0.5, 1.3, 0.5]}}\n"
+       "    particles: {count: [11, 4, 11], distribution: jitter, seed: "
+       "4}\n"
+       "    transform: {rotate: {axis: [1, 0, 1], angle: 3}}\n";
 
 START_TEST(share_overlap) {
   /* many small shares: the pair found across shares */
@@ -257,7 +221,7 @@ START_TEST(share_3d) {
   check_shares(scene3, 0.08, 3); /* fewer particles a cell */
   /* cells smaller than half the spacing: the overlap check needs the
    * whole set */
-  sph_scene *s = load(scene3);
+  sph_scene *s = sph_test_scene_text(scene3);
   sph_particles *ps = NULL;
   int64_t *gidx = NULL, first;
   size_t total;
