@@ -2,8 +2,10 @@
  * bisection of the reference positions balanced by count, ghost layers of
  * one kernel support found with the cell-list search, a fixed halo exchange
  * with MPI_Irecv/MPI_Isend, reductions in rank order and the gather of the
- * output fields to rank 0. Every MPI call of sph is in this file and
- * domain_dynamic.c (the updated-Lagrangian rebuild). */
+ * output fields to rank 0; the same partition, ghosts and halo from each
+ * rank's share of the particles, without the whole set. Every MPI call of
+ * sph is in this file and domain_dynamic.c (the updated-Lagrangian
+ * rebuild). */
 #include "sph/domain.h"
 #include "parallel/domain_impl.h"
 

@@ -5,7 +5,9 @@
  * body). Axes and normals are x, y, z or any vector; a body may be placed
  * by a rotation (Rodrigues' formula) and a translation, its shape, initial
  * velocity and own selections being given in its frame. The method and
- * reference blocks are left to their users. */
+ * reference blocks are left to their users. Over MPI ranks a rank can make
+ * its share of the particles alone (issue 20): the bodies' particles
+ * visited three times, counted per cell of the Morton order's grid. */
 #include "sph/scene.h"
 
 #include <ctype.h>
