@@ -30,13 +30,36 @@ int sph_domain_world_size(void);
 
 /* Partitions *ps (every particle, the same on every rank, in storage
  * order) over the ranks: *ps becomes this rank's owned particles in the
- * same relative order; rank 0 keeps the whole set for output
- * (sph_domain_global). Ghosts are the particles of the same body within
- * `support` of an owned one (strictly, as sph_neighbors_build). Refuses a
- * rank count for which a rank would hold more ghosts than owned particles. */
+ * same relative order (rank 0's whole set for output, sph_domain_global, is
+ * gathered back by sph_domain_whole_create). Ghosts are the particles of the
+ * same body within `support` of an owned one (strictly, as
+ * sph_neighbors_build). Refuses a rank count for which a rank would hold more
+ * ghosts than owned particles. */
 sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
                              double support, sph_error *err);
 void sph_domain_destroy(sph_domain *d);
+/* sph_domain_create without the whole set: each rank passes its share of
+ * the N particles (*ps, any subset as sph_scene_build_share makes them,
+ * with their storage indices gidx; *ps becomes the owned set, NULL after
+ * an error past the partition); the owned sets, storage indices,
+ * ghosts and halo are sph_domain_create's. Collective. */
+sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
+                                   const int64_t *gidx, size_t N,
+                                   double support, sph_error *err);
+/* Rank 0's whole set (sph_domain_global) from the owned sets ps of every
+ * rank (collective): reference positions, volumes, initial velocities, ids,
+ * bodies and flags at their storage indices, in the serial order. Made once
+ * (a no-op after, and for NULL). */
+sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
+                                   sph_error *err);
+/* sph_domain_agree over every rank before a domain exists (st for one
+ * rank). */
+sph_status sph_domain_world_agree(sph_status st, sph_error *err);
+/* The same, the error of the failing rank with the lowest key (then the
+ * lowest rank). */
+sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err);
+/* The ranks on this rank's node (sharing its memory; 1 without MPI). */
+int sph_domain_node_size(void);
 
 /* A symmetry or skew-symmetry plane X . n = at (axis: the coordinate axis of
  * n, or -1) whose mirror images the method builds over owned and ghost

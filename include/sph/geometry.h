@@ -23,6 +23,17 @@ double sph_shape_measure(const sph_shape *s, int dim);
 /* Particles of one body in its own frame (the scene applies the body's
  * transform): *x (3 per particle) and *v (volumes), malloc'd,
  * *n of them. Deterministic for a given body (seeded RNG). */
+/* A body's particle before relaxation, in its own frame. */
+typedef sph_status (*sph_point_fn)(void *ctx, const double X[3], double volume,
+                                   sph_error *err);
+
+/* Calls fn for each particle of the body in creation order, as
+ * sph_body_generate makes them (lattice and jitter) but without storing
+ * them, and for a `relax` body its points before the relaxation; *n is the
+ * number visited. Stops at fn's first error. */
+sph_status sph_body_visit(const sph_body *b, int dim, sph_point_fn fn,
+                          void *ctx, size_t *n, sph_error *err);
+
 sph_status sph_body_generate(const sph_body *b, int dim, double **x,
                              double **volume, size_t *n, sph_error *err);
 

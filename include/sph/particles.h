@@ -90,6 +90,14 @@ size_t sph_particles_bytes(const sph_particles *ps);
 sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
                                      sph_error *err);
 
+/* The Morton key sph_particles_sort_morton gives the point X: its cell of
+ * edge `cell` counted from the corner lo, each index clamped to [0, 2^21 -
+ * 1] (into q). */
+uint64_t sph_morton_cell(const double X[3], const double lo[3], double cell,
+                         uint32_t q[3]);
+/* The Morton key of the cell indices q (each below 2^21). */
+uint64_t sph_morton_key(const uint32_t q[3]);
+
 /* storage index of the particle created j-th */
 static inline size_t sph_particles_slot(const sph_particles *ps, size_t j) {
   return ps->slot ? (size_t)ps->slot[j] : j;

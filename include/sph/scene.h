@@ -260,6 +260,27 @@ void sph_scene_destroy(sph_scene *s);
 sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
                                      sph_error *err);
 
+/* One rank's share of the particles sph_scene_build_particles makes, in
+ * the order sph_particles_sort_morton(cell) gives them, without making the
+ * whole set: the particles with storage indices [rank N / size, (rank + 1)
+ * N / size) of the N, with the fields and flags of the whole set's (id: the
+ * creation index), their storage indices in *gidx (malloc'd), N in *total.
+ * Every rank generates every particle three times (bounds and checks, counts
+ * per cell, storage indices), holding a counter per cell of the grid. The
+ * checks are the whole set's, with its messages; bodies that overlap are
+ * found among the share's particles and those of the cells next to them:
+ * that error is this rank's alone, *overlap the creation index of its
+ * first particle (the lowest over the ranks is the whole set's error;
+ * INT64_MAX for every other outcome, the same on every rank). Lattice and
+ * jitter distributions only (not `relax`). *out is NULL (and SPH_OK) when
+ * the cell grid would be larger than 2 cells a particle and 2^22 cells
+ * (far apart bodies), or for several bodies when its cells are smaller
+ * than half the spacing or clamped (sph_morton_cell). */
+sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
+                                 int size, sph_particles **out, int64_t **gidx,
+                                 size_t *total, int64_t *overlap,
+                                 sph_error *err);
+
 /* Whether a boundary imposes values on particles (clamp, roller,
  * velocity); symmetry planes are handled with mirror images instead. */
 int sph_scene_has_essential_bc(const sph_scene *s);

@@ -139,6 +139,19 @@ static uint64_t spread3(uint64_t v) {
   return v;
 }
 
+uint64_t sph_morton_key(const uint32_t q[3]) {
+  return spread3(q[0]) | spread3(q[1]) << 1 | spread3(q[2]) << 2;
+}
+
+uint64_t sph_morton_cell(const double X[3], const double lo[3], double cell,
+                         uint32_t q[3]) {
+  for (int c = 0; c < 3; ++c) {
+    double f = floor((X[c] - lo[c]) / cell);
+    q[c] = (uint32_t)fmin(fmax(f, 0.0), 2097151.0);
+  }
+  return sph_morton_key(q);
+}
+
 static int cmp_key(const void *pa, const void *pb) {
   const morton_key *a = pa, *b = pb;
   if (a->key != b->key)
@@ -176,12 +189,8 @@ sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
     return sph_error_set(err, SPH_ERR_NOMEM, "particle order (%zu)", n);
   }
   for (size_t a = 0; a < n; ++a) {
-    uint64_t key = 0;
-    for (int c = 0; c < 3; ++c) {
-      double q = floor((X[3 * a + c] - lo[c]) / cell);
-      key |= spread3((uint64_t)fmin(fmax(q, 0.0), 2097151.0)) << c;
-    }
-    k[a] = (morton_key){key, a};
+    uint32_t q[3];
+    k[a] = (morton_key){sph_morton_cell(X + 3 * a, lo, cell, q), a};
   }
   qsort(k, n, sizeof *k, cmp_key);
   for (int f = 0; f < SPH_FIELD_COUNT; ++f)

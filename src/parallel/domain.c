@@ -2,8 +2,10 @@
  * bisection of the reference positions balanced by count, ghost layers of
  * one kernel support found with the cell-list search, a fixed halo exchange
  * with MPI_Irecv/MPI_Isend, reductions in rank order and the gather of the
- * output fields to rank 0. Every MPI call of sph is in this file and
- * domain_dynamic.c (the updated-Lagrangian rebuild). */
+ * output fields to rank 0; the same partition, ghosts and halo from each
+ * rank's share of the particles, without the whole set. Every MPI call of
+ * sph is in this file and domain_dynamic.c (the updated-Lagrangian
+ * rebuild). */
 #include "sph/domain.h"
 #include "parallel/domain_impl.h"
 
@@ -532,7 +534,7 @@ static sph_status owned_set(const sph_particles *ps, const sph_domain *d,
 
 /* who needs what: ghost storage indices to their owners, answered with the
  * owned indices to send */
-static sph_status exchange_plan(sph_domain *d, const int *owner,
+static sph_status exchange_plan(sph_domain *d, const int *gowner,
                                 sph_error *err) {
   int R = d->size;
   d->recv_count = calloc((size_t)R, sizeof(int));
@@ -544,7 +546,7 @@ static sph_status exchange_plan(sph_domain *d, const int *owner,
       !d->req)
     return sph_error_set(err, SPH_ERR_NOMEM, "halo plan");
   for (size_t g = 0; g < d->ng; ++g)
-    d->recv_count[owner[d->gidx[d->n + g]]]++;
+    d->recv_count[gowner[g]]++;
   for (int q = 0; q < R; ++q)
     d->recv_off[q + 1] = d->recv_off[q] + d->recv_count[q];
   MPI_Alltoall(d->recv_count, 1, MPI_INT, d->send_count, 1, MPI_INT,
@@ -607,6 +609,31 @@ void sph_domain_gather_map(sph_domain *d) {
   }
   MPI_Gatherv(d->gidx, n, MPI_INT64_T, d->all_gidx, d->all_count, d->all_off,
               MPI_INT64_T, 0, MPI_COMM_WORLD);
+}
+
+/* a halo larger than the domain (ng_support ghosts within one support):
+ * more ranks than useful; then the exchange's plan from the ghosts'
+ * owners (collective, agreed) */
+static sph_status halo_plan(sph_domain *d, sph_status st, size_t ng_support,
+                            size_t N, const int *gowner, sph_error *err) {
+  long worst = -1;
+  if (st == SPH_OK && (ng_support > d->n || d->n == 0))
+    worst = world_rank;
+  st = sph_domain_agree(d, st, err);
+  long any = -1;
+  if (st == SPH_OK) {
+    MPI_Allreduce(&worst, &any, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+    if (any >= 0)
+      st = sph_error_set(err, SPH_ERR_RANGE,
+                         "%d ranks are more than useful for %zu particles: "
+                         "rank %ld would own no particle or hold more ghost "
+                         "particles (one kernel support around its own) than "
+                         "particles it owns; run on fewer ranks",
+                         world_size, N, any);
+  }
+  if (st == SPH_OK)
+    st = exchange_plan(d, gowner, err);
+  return sph_domain_agree(d, st, err);
 }
 
 /* the partition; a dynamic domain (updated Lagrangian) finds no ghosts
@@ -696,25 +723,13 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
       d->gid[j] = all->id[i];
     }
   }
-  /* a halo larger than the domain: more ranks than useful */
-  long worst = -1;
-  if (st == SPH_OK && (ng_support > d->n || d->n == 0))
-    worst = world_rank;
-  st = sph_domain_agree(d, st, err);
-  long any = -1;
-  if (st == SPH_OK) {
-    MPI_Allreduce(&worst, &any, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
-    if (any >= 0)
-      st = sph_error_set(err, SPH_ERR_RANGE,
-                         "%d ranks are more than useful for %zu particles: "
-                         "rank %ld would own no particle or hold more ghost "
-                         "particles (one kernel support around its own) than "
-                         "particles it owns; run on fewer ranks",
-                         world_size, N, any);
-  }
-  if (st == SPH_OK)
-    st = exchange_plan(d, owner, err);
-  st = sph_domain_agree(d, st, err);
+  int *gowner = NULL;
+  if (st == SPH_OK && !(gowner = malloc((d->ng + 1) * sizeof *gowner)))
+    st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
+  for (size_t g = 0; st == SPH_OK && g < d->ng; ++g)
+    gowner[g] = owner[d->gidx[d->n + g]];
+  st = halo_plan(d, st, ng_support, N, gowner, err);
+  free(gowner);
   sph_particles *mine = NULL;
   if (st == SPH_OK)
     st = owned_set(all, d, cap > d->n ? cap : d->n, &mine, err);
@@ -734,11 +749,9 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
     sph_domain_destroy(d);
     return st;
   }
-  /* rank 0 keeps the whole set for the outputs */
-  if (world_rank == 0)
-    d->all = all;
-  else
-    sph_particles_destroy(all);
+  /* rank 0's whole set is gathered back when needed
+   * (sph_domain_whole_create) */
+  sph_particles_destroy(all);
   *ps = mine;
   *out = d;
   return SPH_OK;
@@ -759,6 +772,426 @@ sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
 sph_status sph_domain_create_dynamic(sph_domain **out, sph_particles **ps,
                                      double support, sph_error *err) {
   return domain_create(out, ps, support, 1, NULL, 0, err);
+}
+
+/* ---- the partition from each rank's share (no whole set) -------------- */
+
+/* a particle as sent between ranks */
+typedef struct share_rec {
+  double X[3], V, v[3];
+  int64_t id, g; /* particle id, storage index */
+  int32_t body, owner;
+  uint32_t flags;
+  int32_t edge; /* an owned one within another rank's widened box */
+} share_rec;
+
+static int cmp_rec_storage(const void *pa, const void *pb) {
+  const share_rec *a = pa, *b = pb;
+  return (a->g > b->g) - (a->g < b->g);
+}
+
+static int cmp_rec_owner(const void *pa, const void *pb) {
+  const share_rec *a = pa, *b = pb;
+  if (a->owner != b->owner)
+    return a->owner < b->owner ? -1 : 1;
+  return (a->g > b->g) - (a->g < b->g);
+}
+
+/* the records send (grouped by destination, count[q] to rank q) to their
+ * ranks: *recv (malloc'd, each record's owner its sender), *nrecv of them
+ * (collective) */
+static sph_status send_recs(const share_rec *send, const int *count,
+                            MPI_Datatype type, share_rec **recv, size_t *nrecv,
+                            sph_error *err) {
+  int R = world_size;
+  int *rcount = malloc(4 * (size_t)R * sizeof *rcount);
+  int *soff = rcount + R, *roff = rcount + 2 * R, *scount = rcount + 3 * R;
+  int ok = rcount != NULL, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (!all) {
+    free(rcount);
+    return sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
+  }
+  memcpy(scount, count, (size_t)R * sizeof *scount);
+  MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
+  size_t n = 0;
+  for (int q = 0; q < R; ++q) {
+    soff[q] = q ? soff[q - 1] + scount[q - 1] : 0;
+    roff[q] = (int)n;
+    n += (size_t)rcount[q];
+  }
+  *recv = malloc((n ? n : 1) * sizeof **recv);
+  ok = *recv != NULL;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (all)
+    MPI_Alltoallv(send, scount, soff, type, *recv, rcount, roff, type,
+                  MPI_COMM_WORLD);
+  for (int q = 0; all && q < R; ++q)
+    for (int k = 0; k < rcount[q]; ++k)
+      (*recv)[roff[q] + k].owner = q;
+  free(rcount);
+  *nrecv = n;
+  if (!all) {
+    free(*recv);
+    *recv = NULL;
+    return sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
+  }
+  return SPH_OK;
+}
+
+/* the ghosts among the owned records own (storage order) and the
+ * candidates cand (others' particles in the owned box widened by
+ * `support`): as find_ghosts, whose pairs of an owned particle and another
+ * rank's are those among the candidates and the owned particles within
+ * their ranks' widened boxes (edge); *ghost (malloc'd) by owner and
+ * storage index */
+static sph_status share_ghosts(const share_rec *own, size_t n, share_rec *cand,
+                               size_t nc, int dim, double support,
+                               share_rec **ghost, size_t *ng, sph_error *err) {
+  size_t m = nc;
+  for (size_t a = 0; a < n; ++a)
+    m += own[a].edge != 0;
+  share_rec *all = malloc((m ? m : 1) * sizeof *all);
+  double *cx = malloc(3 * (m ? m : 1) * sizeof *cx);
+  int32_t *cb = malloc((m ? m : 1) * sizeof *cb);
+  char *is_ghost = calloc(m ? m : 1, 1);
+  sph_neighbors *nl = NULL;
+  sph_status st = all && cx && cb && is_ghost
+                      ? sph_neighbors_create(&nl, err)
+                      : sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  if (st == SPH_OK) {
+    memcpy(all, cand, nc * sizeof *all);
+    for (size_t a = 0, j = nc; a < n; ++a)
+      if (own[a].edge)
+        all[j++] = own[a];
+    qsort(all, m, sizeof *all, cmp_rec_storage);
+    for (size_t j = 0; j < m; ++j) {
+      memcpy(cx + 3 * j, all[j].X, 3 * sizeof *cx);
+      cb[j] = all[j].body;
+    }
+    st = sph_neighbors_build(nl, cx, m, dim, support, cb, SPH_PAIRS_SAME_BODY,
+                             err);
+  }
+  for (size_t j = 0; st == SPH_OK && j < m; ++j) {
+    if (all[j].owner != world_rank)
+      continue;
+    for (size_t k = nl->offset[j]; k < nl->offset[j + 1]; ++k)
+      if (all[nl->index[k]].owner != world_rank)
+        is_ghost[nl->index[k]] = 1;
+  }
+  *ng = 0;
+  for (size_t j = 0; st == SPH_OK && j < m; ++j)
+    if (is_ghost[j])
+      all[(*ng)++] = all[j];
+  if (st == SPH_OK)
+    qsort(all, *ng, sizeof *all, cmp_rec_owner);
+  sph_neighbors_destroy(nl);
+  free(cx);
+  free(cb);
+  free(is_ghost);
+  if (st != SPH_OK) {
+    free(all);
+    all = NULL;
+  }
+  *ghost = all;
+  return st;
+}
+
+/* the owned set from the owned records, in storage order */
+static sph_status share_owned_set(const share_rec *own, size_t n, int dim,
+                                  sph_particles **out, sph_error *err) {
+  SPH_TRY(sph_particles_create(out, n, dim, err));
+  sph_particles *o = *out;
+  SPH_TRY(sph_particles_require(o, SPH_FIELD_VELOCITY, err));
+  for (size_t a = 0; a < n; ++a) {
+    memcpy(o->field[SPH_FIELD_POSITION0] + 3 * a, own[a].X, 3 * sizeof(double));
+    o->field[SPH_FIELD_VOLUME0][a] = own[a].V;
+    memcpy(o->field[SPH_FIELD_VELOCITY] + 3 * a, own[a].v, 3 * sizeof(double));
+    o->id[a] = own[a].id;
+    o->body[a] = own[a].body;
+    o->flags[a] = own[a].flags;
+  }
+  o->n = n;
+  return SPH_OK;
+}
+
+/* find_ghosts' test: X in the box lo, hi (6 values) widened by w */
+static int in_box(const double *box, const double X[3], int dim, double w) {
+  int in = 1;
+  for (int c = 0; c < dim; ++c)
+    in &= X[c] >= box[c] - w && X[c] <= box[3 + c] + w;
+  return in;
+}
+
+/* each rank's owned records to the ranks whose owned box, widened by
+ * `support`, holds them (collective) */
+static sph_status share_candidates(share_rec *own, size_t n, int dim,
+                                   double support, MPI_Datatype type,
+                                   share_rec **cand, size_t *nc,
+                                   sph_error *err) {
+  int R = world_size;
+  double box[6] = {INFINITY,  INFINITY,  INFINITY,
+                   -INFINITY, -INFINITY, -INFINITY};
+  for (size_t a = 0; a < n; ++a)
+    for (int c = 0; c < dim; ++c) {
+      box[c] = fmin(box[c], own[a].X[c]);
+      box[3 + c] = fmax(box[3 + c], own[a].X[c]);
+    }
+  double *boxes = malloc(6 * (size_t)R * sizeof *boxes);
+  int *count = calloc((size_t)R, sizeof *count);
+  int ok = boxes && count, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (!all) {
+    free(boxes);
+    free(count);
+    return sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  }
+  MPI_Allgather(box, 6, MPI_DOUBLE, boxes, 6, MPI_DOUBLE, MPI_COMM_WORLD);
+  size_t total = 0;
+  for (int q = 0; q < R; ++q)
+    for (size_t a = 0; q != world_rank && a < n; ++a)
+      if (in_box(boxes + 6 * q, own[a].X, dim, support))
+        count[q]++, own[a].edge = 1;
+  for (int q = 0; q < R; ++q)
+    total += (size_t)count[q];
+  share_rec *send = malloc((total ? total : 1) * sizeof *send);
+  ok = send != NULL;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  sph_status st =
+      all ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  size_t k = 0;
+  for (int q = 0; st == SPH_OK && q < R; ++q)
+    for (size_t a = 0; q != world_rank && a < n; ++a)
+      if (in_box(boxes + 6 * q, own[a].X, dim, support))
+        send[k++] = own[a];
+  if (st == SPH_OK)
+    st = send_recs(send, count, type, cand, nc, err);
+  free(send);
+  free(boxes);
+  free(count);
+  return st;
+}
+
+sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
+                                   const int64_t *gidx, size_t N,
+                                   double support, sph_error *err) {
+  *out = NULL;
+  sph_particles *in = *ps;
+  size_t m = in->n;
+  int R = world_size, dim = in->dim;
+  sph_domain *d = calloc(1, sizeof *d);
+  int *owner = malloc((m ? m : 1) * sizeof *owner);
+  int *count = calloc((size_t)R, sizeof *count);
+  share_rec *send = malloc((m ? m : 1) * sizeof *send);
+  if (d) {
+    d->rank = world_rank;
+    d->size = world_size;
+    d->dim = dim;
+    d->gathered = ~0ul;
+    d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
+  }
+  sph_status st = d && d->sums && owner && count && send
+                      ? SPH_OK
+                      : sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
+  sph_domain world = {.rank = world_rank, .size = world_size};
+  st = sph_domain_agree(&world, st, err);
+  MPI_Datatype type;
+  MPI_Type_contiguous((int)sizeof(share_rec), MPI_BYTE, &type);
+  MPI_Type_commit(&type);
+  /* sph_domain_rcb's partition: ties by storage index */
+  if (st == SPH_OK) {
+    sph_domain_rcb_counted(in->field[SPH_FIELD_POSITION0], gidx, m, dim, owner,
+                           NULL, NULL, NULL);
+    for (size_t i = 0; i < m; ++i)
+      if (owner[i] < 0)
+        st = sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
+  }
+  /* every particle to its owner */
+  share_rec *own = NULL, *cand = NULL, *ghost = NULL;
+  size_t nc = 0, ng = 0;
+  if (st == SPH_OK) {
+    int *at = calloc((size_t)R + 1, sizeof *at);
+    for (size_t i = 0; at && i < m; ++i)
+      count[owner[i]]++, at[owner[i] + 1]++;
+    for (int q = 0; at && q < R; ++q)
+      at[q + 1] += at[q];
+    for (size_t i = 0; at && i < m; ++i) {
+      share_rec *r = &send[at[owner[i]]++];
+      memcpy(r->X, in->field[SPH_FIELD_POSITION0] + 3 * i, sizeof r->X);
+      r->V = in->field[SPH_FIELD_VOLUME0][i];
+      memcpy(r->v, in->field[SPH_FIELD_VELOCITY] + 3 * i, sizeof r->v);
+      r->id = in->id[i];
+      r->g = gidx[i];
+      r->body = in->body[i];
+      r->flags = in->flags[i];
+      r->edge = 0;
+    }
+    st = sph_domain_agree(
+        &world, at ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "ghosts"), err);
+    free(at);
+  }
+  /* the share is in the records now */
+  if (st == SPH_OK) {
+    sph_particles_destroy(in);
+    *ps = NULL;
+  }
+  if (st == SPH_OK)
+    st = send_recs(send, count, type, &own, &d->n, err);
+  free(send);
+  free(count);
+  free(owner);
+  if (st == SPH_OK) {
+    qsort(own, d->n, sizeof *own, cmp_rec_storage);
+    for (size_t a = 0; a < d->n; ++a)
+      own[a].owner = world_rank;
+    st = share_candidates(own, d->n, dim, support, type, &cand, &nc, err);
+  }
+  if (st == SPH_OK)
+    st = share_ghosts(own, d->n, cand, nc, dim, support, &ghost, &ng, err);
+  free(cand);
+  if (st == SPH_OK) {
+    d->ng = ng;
+    d->gidx = malloc((d->n + ng ? d->n + ng : 1) * sizeof *d->gidx);
+    d->gX = malloc(3 * (ng + 1) * sizeof *d->gX);
+    d->gV = malloc((ng + 1) * sizeof *d->gV);
+    d->gbody = malloc((ng + 1) * sizeof *d->gbody);
+    d->gid = malloc((ng + 1) * sizeof *d->gid);
+    if (!d->gidx || !d->gX || !d->gV || !d->gbody || !d->gid)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
+  }
+  int *gowner = NULL;
+  if (st == SPH_OK && !(gowner = malloc((ng + 1) * sizeof *gowner)))
+    st = sph_error_set(err, SPH_ERR_NOMEM, "ghosts");
+  if (st == SPH_OK) {
+    for (size_t a = 0; a < d->n; ++a)
+      d->gidx[a] = own[a].g;
+    for (size_t j = 0; j < ng; ++j) {
+      d->gidx[d->n + j] = ghost[j].g;
+      memcpy(d->gX + 3 * j, ghost[j].X, 3 * sizeof *d->gX);
+      d->gV[j] = ghost[j].V;
+      d->gbody[j] = ghost[j].body;
+      d->gid[j] = ghost[j].id;
+      gowner[j] = ghost[j].owner;
+    }
+  }
+  free(ghost);
+  MPI_Type_free(&type);
+  st = sph_domain_agree(&world, st, err);
+  if (st == SPH_OK)
+    st = halo_plan(d, st, ng, N, gowner, err);
+  free(gowner);
+  sph_particles *mine = NULL;
+  if (st == SPH_OK)
+    st = share_owned_set(own, d->n, dim, &mine, err);
+  free(own);
+  st = sph_domain_agree(&world, st, err);
+  if (st == SPH_OK)
+    st = gather_plan(d, N, err);
+  if (st != SPH_OK) {
+    sph_particles_destroy(mine);
+    sph_domain_destroy(d);
+    return st;
+  }
+  *ps = mine;
+  *out = d;
+  return SPH_OK;
+}
+
+/* rank 0's whole set: the creation fields of every rank's owned particles
+ * at their storage indices (collective) */
+sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
+                                   sph_error *err) {
+  if (!d || d->all)
+    return SPH_OK;
+  static const sph_field fields[] = {SPH_FIELD_POSITION0, SPH_FIELD_VOLUME0,
+                                     SPH_FIELD_VELOCITY};
+  size_t N = d->rank == 0 ? (size_t)d->all_off[d->size] : 0;
+  sph_particles *all = NULL;
+  sph_status st = SPH_OK;
+  if (d->rank == 0) {
+    st = sph_particles_create(&all, N, d->dim, err);
+    if (st == SPH_OK)
+      st = sph_particles_require(all, SPH_FIELD_VELOCITY, err);
+    if (st == SPH_OK && !(all->slot = malloc((N ? N : 1) * sizeof *all->slot)))
+      st = sph_error_set(err, SPH_ERR_NOMEM, "whole set (%zu)", N);
+  }
+  st = sph_domain_agree(d, st, err);
+  if (st != SPH_OK) {
+    sph_particles_destroy(all);
+    return st;
+  }
+  const int64_t *at = d->all_gidx;
+  int n = (int)d->n;
+  for (size_t k = 0; k < sizeof fields / sizeof *fields; ++k) {
+    int nc = sph_field_components(fields[k]);
+    if (d->rank == 0)
+      for (int q = 0; q < d->size; ++q) {
+        d->counts[q] = nc * d->all_count[q];
+        d->offs[q] = nc * d->all_off[q];
+      }
+    MPI_Gatherv(ps->field[fields[k]], nc * n, MPI_DOUBLE, d->gbuf, d->counts,
+                d->offs, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    for (size_t j = 0; d->rank == 0 && j < N; ++j)
+      memcpy(all->field[fields[k]] + (size_t)nc * (size_t)at[j],
+             d->gbuf + (size_t)nc * j, (size_t)nc * sizeof(double));
+  }
+  MPI_Gatherv(ps->id, n, MPI_INT64_T, d->gbuf, d->all_count, d->all_off,
+              MPI_INT64_T, 0, MPI_COMM_WORLD);
+  for (size_t j = 0; d->rank == 0 && j < N; ++j)
+    memcpy(all->id + at[j], (const int64_t *)d->gbuf + j, sizeof *all->id);
+  MPI_Gatherv(ps->body, n, MPI_INT32_T, d->gbuf, d->all_count, d->all_off,
+              MPI_INT32_T, 0, MPI_COMM_WORLD);
+  for (size_t j = 0; d->rank == 0 && j < N; ++j)
+    all->body[at[j]] = ((const int32_t *)d->gbuf)[j];
+  MPI_Gatherv(ps->flags, n, MPI_UINT32_T, d->gbuf, d->all_count, d->all_off,
+              MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  for (size_t j = 0; d->rank == 0 && j < N; ++j)
+    all->flags[at[j]] = ((const uint32_t *)d->gbuf)[j];
+  if (d->rank == 0) {
+    all->n = N;
+    for (size_t i = 0; i < N; ++i)
+      all->slot[all->id[i]] = (int64_t)i;
+    d->all = all;
+  }
+  return SPH_OK;
+}
+
+sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
+  return sph_domain_world_first(st, INT64_MAX, err);
+}
+
+sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err) {
+  if (world_size < 2)
+    return st;
+  /* the failing rank of the lowest key, then of the lowest rank */
+  int64_t mine[2] = {st != SPH_OK ? key : INT64_MAX,
+                     st != SPH_OK ? world_rank : world_size},
+          low[2];
+  MPI_Allreduce(mine, low, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+  if (mine[0] != low[0])
+    mine[1] = world_size;
+  MPI_Allreduce(mine + 1, low + 1, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+  if (low[1] == world_size)
+    return SPH_OK;
+  sph_error e;
+  if (low[1] == world_rank)
+    e = *err;
+  MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, (int)low[1], MPI_COMM_WORLD);
+  *err = e;
+  return e.code != SPH_OK ? e.code : SPH_ERR_IO;
+}
+
+int sph_domain_node_size(void) {
+  if (world_size < 2)
+    return 1;
+  MPI_Comm node;
+  int n = 1;
+  if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, world_rank,
+                          MPI_INFO_NULL, &node) != MPI_SUCCESS)
+    return world_size;
+  MPI_Comm_size(node, &n);
+  MPI_Comm_free(&node);
+  return n;
 }
 
 sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
@@ -946,6 +1379,31 @@ sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
   (void)planes, (void)nplanes;
   return sph_domain_create(out, ps, support, err);
 }
+
+sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
+                                   const int64_t *gidx, size_t N,
+                                   double support, sph_error *err) {
+  (void)gidx, (void)N;
+  return sph_domain_create(out, ps, support, err);
+}
+
+sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
+                                   sph_error *err) {
+  (void)d, (void)ps, (void)err;
+  return SPH_OK;
+}
+
+sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
+  (void)err;
+  return st;
+}
+
+sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err) {
+  (void)key, (void)err;
+  return st;
+}
+
+int sph_domain_node_size(void) { return 1; }
 
 sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
                                sph_error *err) {

@@ -237,122 +237,123 @@ static double rng_uniform(uint64_t *state) {
 typedef struct pointset {
   double *x, *v;
   size_t n, cap;
-  double h[3]; /* lattice spacing per axis */
 } pointset;
 
-static int push(pointset *p, const double X[3], double volume) {
+static sph_status push(void *ctx, const double X[3], double volume,
+                       sph_error *err) {
+  pointset *p = ctx;
   if (p->n == p->cap) {
     size_t c = p->cap ? 2 * p->cap : 1024;
     double *x = realloc(p->x, 3 * c * sizeof *x);
     if (!x)
-      return -1;
+      return sph_error_set(err, SPH_ERR_NOMEM, "particles");
     p->x = x;
     double *v = realloc(p->v, c * sizeof *v);
     if (!v)
-      return -1;
+      return sph_error_set(err, SPH_ERR_NOMEM, "particles");
     p->v = v;
     p->cap = c;
   }
   memcpy(p->x + 3 * p->n, X, 3 * sizeof *X);
   p->v[p->n++] = volume;
-  return 0;
+  return SPH_OK;
 }
 
 /* more lattice points than this is a mistake in the scene */
 #define LATTICE_MAX 2147483647.0
 
-static sph_status lattice_faces(const sph_body *b, int dim, pointset *p,
-                                sph_error *err) {
+/* a body's lattice: points per axis, spacing per axis, first point */
+typedef struct lattice {
+  const sph_body *b;
+  int dim, faces, box;
+  long n[3];
+  double lo[3], h[3], vol;
+  uint64_t state; /* the jitter's stream */
+} lattice;
+
+static sph_status lattice_faces(lattice *L, sph_error *err) {
+  const sph_body *b = L->b;
   const sph_shape *s = &b->shape;
-  int n[3] = {1, 1, 1};
   double total = 1.0;
-  for (int c = 0; c < dim; ++c) {
-    n[c] = b->count[c];
-    p->h[c] = (s->max[c] - s->min[c]) / (n[c] - 1);
-    total *= n[c];
+  for (int c = 0; c < L->dim; ++c) {
+    L->n[c] = b->count[c];
+    L->h[c] = (s->max[c] - s->min[c]) / (b->count[c] - 1);
+    total *= b->count[c];
   }
   if (total > LATTICE_MAX)
     return sph_error_set(err, SPH_ERR_GEOMETRY,
                          "body '%s': %.3g particles are too many", b->name,
                          total);
-  for (int i = 0; i < n[0]; ++i)
-    for (int j = 0; j < n[1]; ++j)
-      for (int k = 0; k < n[2]; ++k) {
-        int idx[3] = {i, j, k};
-        double X[3] = {0, 0, 0}, vol = 1.0;
-        for (int c = 0; c < dim; ++c) {
-          /* the last layer sits exactly on the max face */
-          X[c] = idx[c] == n[c] - 1 ? s->max[c] : s->min[c] + idx[c] * p->h[c];
-          vol *= (idx[c] == 0 || idx[c] == n[c] - 1) ? 0.5 * p->h[c] : p->h[c];
-        }
-        if (push(p, X, vol))
-          return sph_error_set(err, SPH_ERR_NOMEM, "particles of body '%s'",
-                               b->name);
-      }
   return SPH_OK;
 }
 
-static sph_status lattice_cells(const sph_body *b, int dim, pointset *p,
-                                sph_error *err) {
+static sph_status lattice_cells(lattice *L, sph_error *err) {
+  const sph_body *b = L->b;
   const sph_shape *s = &b->shape;
-  int box = s->kind == SPH_SHAPE_BOX;
-  double lo[3], hi[3], total = 1.0;
-  long n[3] = {1, 1, 1};
-  sph_shape_bounds(s, dim, lo, hi);
-  for (int c = 0; c < dim; ++c) {
-    double len = hi[c] - lo[c], cells = len / b->spacing;
+  double hi[3], total = 1.0;
+  sph_shape_bounds(s, L->dim, L->lo, hi);
+  for (int c = 0; c < L->dim; ++c) {
+    double len = hi[c] - L->lo[c], cells = len / b->spacing;
     if (cells > LATTICE_MAX)
       cells = LATTICE_MAX + 1.0;
     /* boxes are tiled exactly by n cells; other shapes keep dp */
-    n[c] = box ? (long)floor(cells + 0.5) : (long)ceil(cells) + 1;
-    p->h[c] = box && n[c] > 0 ? len / (double)n[c] : b->spacing;
-    total *= (double)n[c];
+    L->n[c] = L->box ? (long)floor(cells + 0.5) : (long)ceil(cells) + 1;
+    L->h[c] = L->box && L->n[c] > 0 ? len / (double)L->n[c] : b->spacing;
+    total *= (double)L->n[c];
   }
   if (total > LATTICE_MAX)
     return sph_error_set(err, SPH_ERR_GEOMETRY,
                          "body '%s': spacing %g gives %.3g lattice points, too "
                          "many",
                          b->name, b->spacing, total);
-  double vol = 1.0;
-  for (int c = 0; c < dim; ++c)
-    vol *= p->h[c];
-  for (long i = 0; i < n[0]; ++i)
-    for (long j = 0; j < n[1]; ++j)
-      for (long k = 0; k < n[2]; ++k) {
-        long idx[3] = {i, j, k};
-        double X[3] = {0, 0, 0};
-        for (int c = 0; c < dim; ++c)
-          X[c] = lo[c] + ((double)idx[c] + 0.5) * p->h[c];
-        if (!box && !(sph_shape_distance(s, dim, X) < 0.0))
-          continue;
-        if (push(p, X, vol))
-          return sph_error_set(err, SPH_ERR_NOMEM, "particles of body '%s'",
-                               b->name);
-      }
+  L->vol = 1.0;
+  for (int c = 0; c < L->dim; ++c)
+    L->vol *= L->h[c];
   return SPH_OK;
+}
+
+/* lattice point idx into X with its volume; 0 when outside the shape */
+static int lattice_point(const lattice *L, const long idx[3], double X[3],
+                         double *vol) {
+  const sph_shape *s = &L->b->shape;
+  X[0] = X[1] = X[2] = 0.0;
+  if (L->faces) {
+    *vol = 1.0;
+    for (int c = 0; c < L->dim; ++c) {
+      /* the last layer sits exactly on the max face */
+      X[c] = idx[c] == L->n[c] - 1 ? s->max[c]
+                                   : s->min[c] + (double)idx[c] * L->h[c];
+      *vol *= (idx[c] == 0 || idx[c] == L->n[c] - 1) ? 0.5 * L->h[c] : L->h[c];
+    }
+    return 1;
+  }
+  *vol = L->vol;
+  for (int c = 0; c < L->dim; ++c)
+    X[c] = L->lo[c] + ((double)idx[c] + 0.5) * L->h[c];
+  return L->box || sph_shape_distance(s, L->dim, X) < 0.0;
 }
 
 /* ---- jitter -------------------------------------------------------------- */
 
-static void jitter(const sph_body *b, int dim, pointset *p) {
+/* the next particle's offset, drawn from the body's stream in creation
+ * order */
+static void jitter(lattice *L, double X[3]) {
+  const sph_body *b = L->b;
   const sph_shape *s = &b->shape;
-  int faces = b->lattice == SPH_LATTICE_FACES;
-  uint64_t state = (uint64_t)b->seed;
-  for (size_t i = 0; i < p->n; ++i) {
-    double *X = p->x + 3 * i, Y[3] = {X[0], X[1], X[2]};
-    int inside = 1;
-    for (int c = 0; c < dim; ++c) {
-      double u = rng_uniform(&state); /* drawn always: one stream per seed */
-      /* face particles stay on their faces */
-      if (faces && (X[c] == s->min[c] || X[c] == s->max[c]))
-        continue;
-      Y[c] += b->jitter * p->h[c] * u;
-      inside = inside && (!faces || (Y[c] > s->min[c] && Y[c] < s->max[c]));
-    }
-    /* a particle that would leave the shape keeps its lattice place */
-    if (faces ? inside : sph_shape_distance(s, dim, Y) < 0.0)
-      memcpy(X, Y, sizeof Y);
+  int dim = L->dim, faces = L->faces;
+  double Y[3] = {X[0], X[1], X[2]};
+  int inside = 1;
+  for (int c = 0; c < dim; ++c) {
+    double u = rng_uniform(&L->state); /* drawn always: one stream per seed */
+    /* face particles stay on their faces */
+    if (faces && (X[c] == s->min[c] || X[c] == s->max[c]))
+      continue;
+    Y[c] += b->jitter * L->h[c] * u;
+    inside = inside && (!faces || (Y[c] > s->min[c] && Y[c] < s->max[c]));
   }
+  /* a particle that would leave the shape keeps its lattice place */
+  if (faces ? inside : sph_shape_distance(s, dim, Y) < 0.0)
+    memcpy(X, Y, sizeof Y);
 }
 
 /* ---- relaxation ---------------------------------------------------------- */
@@ -575,22 +576,47 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
   return SPH_OK;
 }
 
-sph_status sph_body_generate(const sph_body *b, int dim, double **x,
-                             double **volume, size_t *n, sph_error *err) {
-  *x = *volume = NULL;
+sph_status sph_body_visit(const sph_body *b, int dim, sph_point_fn fn,
+                          void *ctx, size_t *n, sph_error *err) {
   *n = 0;
   SPH_TRY(check_body(b, dim, err));
-  pointset p = {0};
-  sph_status st = b->lattice == SPH_LATTICE_FACES
-                      ? lattice_faces(b, dim, &p, err)
-                      : lattice_cells(b, dim, &p, err);
-  if (st == SPH_OK && p.n == 0)
+  lattice L = {.b = b,
+               .dim = dim,
+               .faces = b->lattice == SPH_LATTICE_FACES,
+               .box = b->shape.kind == SPH_SHAPE_BOX,
+               .n = {1, 1, 1},
+               .state = (uint64_t)b->seed};
+  SPH_TRY(L.faces ? lattice_faces(&L, err) : lattice_cells(&L, err));
+  sph_status st = SPH_OK;
+  int jittered = b->distribution != SPH_DIST_LATTICE;
+  long idx[3];
+  for (idx[0] = 0; st == SPH_OK && idx[0] < L.n[0]; ++idx[0])
+    for (idx[1] = 0; st == SPH_OK && idx[1] < L.n[1]; ++idx[1])
+      for (idx[2] = 0; st == SPH_OK && idx[2] < L.n[2]; ++idx[2]) {
+        double X[3], vol;
+        if (!lattice_point(&L, idx, X, &vol))
+          continue;
+        if (jittered)
+          jitter(&L, X);
+        st = fn(ctx, X, vol, err);
+        *n += st == SPH_OK;
+      }
+  if (st == SPH_OK && *n == 0)
     st = sph_error_set(err, SPH_ERR_GEOMETRY,
                        "body '%s' has no particles: spacing %g is larger than "
                        "the shape",
                        b->name, b->spacing);
-  if (st == SPH_OK && b->distribution != SPH_DIST_LATTICE)
-    jitter(b, dim, &p);
+  return st;
+}
+
+sph_status sph_body_generate(const sph_body *b, int dim, double **x,
+                             double **volume, size_t *n, sph_error *err) {
+  *x = *volume = NULL;
+  *n = 0;
+  pointset p = {0};
+  sph_status st = sph_body_visit(b, dim, push, &p, n, err);
+  if (st == SPH_ERR_NOMEM)
+    st = sph_error_set(err, SPH_ERR_NOMEM, "particles of body '%s'", b->name);
   if (st == SPH_OK && b->distribution == SPH_DIST_RELAX) {
     st = relax(b, dim, &p, err);
     /* equal volumes that add up to the exact measure */
@@ -601,10 +627,10 @@ sph_status sph_body_generate(const sph_body *b, int dim, double **x,
   if (st != SPH_OK) {
     free(p.x);
     free(p.v);
+    *n = 0;
     return st;
   }
   *x = p.x;
   *volume = p.v;
-  *n = p.n;
   return SPH_OK;
 }

@@ -5,7 +5,9 @@
  * body). Axes and normals are x, y, z or any vector; a body may be placed
  * by a rotation (Rodrigues' formula) and a translation, its shape, initial
  * velocity and own selections being given in its frame. The method and
- * reference blocks are left to their users. */
+ * reference blocks are left to their users. Over MPI ranks a rank can make
+ * its share of the particles alone (issue 20): the bodies' particles
+ * visited three times, counted per cell of the Morton order's grid. */
 #include "sph/scene.h"
 
 #include <ctype.h>
@@ -1438,66 +1440,210 @@ static void initial_velocity(const sph_velocity *v, const double X[3],
   }
 }
 
-static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
+/* What the set-up checks particle by particle, in creation order: the first
+ * particle with a non-finite initial velocity, the first beyond where
+ * doubles resolve the spacing, the selections and probes each reaches, the
+ * first wall with a particle behind it. Shared by the whole set and the
+ * per-rank share (which sees every particle once in its first pass). */
+typedef struct build_checks {
+  int velocity, resolvable; /* found (the error in *_err) */
+  sph_error velocity_err, resolvable_err;
+  char *hit;    /* per boundary: selects a particle */
+  char *inside; /* per probe: within a spacing of a particle */
+  size_t wall;  /* lowest wall with a particle behind it (nwalls: none) */
+  sph_error wall_err;
+} build_checks;
+
+static sph_status checks_create(const sph_scene *s, build_checks *c,
                                 sph_error *err) {
-  if (s->nbodies < 2)
-    return SPH_OK;
+  memset(c, 0, sizeof *c);
+  c->wall = s->contact.nwalls;
+  c->hit = calloc(s->nboundaries + 1, 1);
+  c->inside = calloc(s->output.nprobes + 1, 1);
+  if (!c->hit || !c->inside)
+    return sph_error_set(err, SPH_ERR_NOMEM, "particle checks");
+  return SPH_OK;
+}
+
+static void checks_destroy(build_checks *c) {
+  free(c->hit);
+  free(c->inside);
+}
+
+/* Positions a double can tell apart at the particle spacing: beyond 1e9
+ * spacings from the origin a coordinate's rounding step exceeds 1e-7 dp
+ * (kernel sums and neighbour cells lose their meaning). */
+static void check_resolvable(const sph_scene *s, size_t b, const double X[3],
+                             build_checks *c) {
+  double limit = 1e9 * sph_scene_min_spacing(s);
+  for (int k = 0; k < 3 && !c->resolvable; ++k)
+    if (!(fabs(X[k]) <= limit)) {
+      const sph_body *bd = &s->bodies[b];
+      char key[32];
+      snprintf(key, sizeof key, "bodies[%d]", (int)b);
+      c->resolvable = 1;
+      sph_error_at(
+          &c->resolvable_err, SPH_ERR_GEOMETRY, s->path, bd->line, bd->col, key,
+          "a particle at %g m lies more than 1e9 particle spacings (%g m) "
+          "from the origin, where double precision cannot resolve the "
+          "spacing: place the body nearer the origin",
+          X[k], sph_scene_min_spacing(s));
+    }
+}
+
+/* The particle of body b at Xb (body frame): its world position X, initial
+ * velocity v (world frame) and flags, the checks updated when c is given. */
+static void particle_state(const sph_scene *s, size_t b, const double Xb[3],
+                           double X[3], double v[3], uint32_t *flags,
+                           build_checks *c) {
+  const sph_body *bd = &s->bodies[b];
+  double vb[3];
+  sph_body_world(bd, Xb, X);
+  initial_velocity(&bd->velocity, Xb, vb);
+  if (bd->transform.given)
+    rotate(&bd->transform, vb, v);
+  else
+    memcpy(v, vb, sizeof vb);
+  *flags = 0;
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (sph_selection_contains(s, &s->boundaries[k].select, (int)b, X)) {
+      *flags |= SPH_FLAG_BOUNDARY;
+      if (c)
+        c->hit[k] = 1;
+    }
+  if (!c)
+    return;
+  if (!c->velocity && !isfinite(vb[0] + vb[1] + vb[2])) {
+    char key[48];
+    snprintf(key, sizeof key, "bodies[%zu].initial_velocity", b);
+    c->velocity = 1;
+    sph_error_at(&c->velocity_err, SPH_ERR_RANGE, s->path, bd->line, bd->col,
+                 key, "not finite at (%g, %g, %g) (body frame)", Xb[0], Xb[1],
+                 Xb[2]);
+  }
+  check_resolvable(s, b, X, c);
+  /* probes: within one spacing of a particle */
+  for (size_t k = 0; k < s->output.nprobes; ++k) {
+    const sph_probe *p = &s->output.probes[k];
+    double d2 = 0.0;
+    for (int e = 0; e < s->dimension; ++e)
+      d2 += (X[e] - p->at[e]) * (X[e] - p->at[e]);
+    c->inside[k] |= d2 <= bd->spacing * bd->spacing;
+  }
+  /* walls: no particle starts behind one */
+  for (size_t k = 0; k < c->wall; ++k) {
+    const sph_wall *w = &s->contact.walls[k];
+    double nrm[3], g = sph_wall_distance(w, 0.0, s->dimension, X, nrm);
+    if (g >= 0.0)
+      continue;
+    char key[48];
+    snprintf(key, sizeof key, "contact.walls[%zu]", k);
+    sph_error_at(&c->wall_err, SPH_ERR_GEOMETRY, s->path, w->line, w->col, key,
+                 "body '%s' starts inside wall '%s' (a particle %g m "
+                 "beyond it)",
+                 bd->name, w->name, -g);
+    c->wall = k;
+    break;
+  }
+}
+
+/* the checks' first failure in the serial order: velocities, positions */
+static sph_status checks_first(const build_checks *c, sph_error *err) {
+  if (c->velocity || c->resolvable) {
+    *err = c->velocity ? c->velocity_err : c->resolvable_err;
+    return err->code;
+  }
+  return SPH_OK;
+}
+
+/* then selections, probes and walls */
+static sph_status checks_rest(const sph_scene *s, const build_checks *c,
+                              sph_error *err) {
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (!c->hit[k]) {
+      const sph_boundary *bc = &s->boundaries[k];
+      char key[48];
+      snprintf(key, sizeof key, "boundaries[%zu].select", k);
+      return sph_error_at(err, SPH_ERR_GEOMETRY, s->path, bc->line, bc->col,
+                          key, "boundary '%s' selects no particle", bc->name);
+    }
+  for (size_t k = 0; k < s->output.nprobes; ++k)
+    if (!c->inside[k]) {
+      const sph_probe *p = &s->output.probes[k];
+      char key[48];
+      snprintf(key, sizeof key, "output.probes[%zu].at", k);
+      return sph_error_at(err, SPH_ERR_GEOMETRY, s->path, p->line, p->col, key,
+                          "probe '%s' at (%g, %g, %g) is outside every body",
+                          p->name, p->at[0], p->at[1],
+                          s->dimension == 3 ? p->at[2] : 0.0);
+    }
+  if (c->wall < s->contact.nwalls) {
+    *err = c->wall_err;
+    return err->code;
+  }
+  return SPH_OK;
+}
+
+/* a body's generation error at its key */
+static sph_status body_error(const sph_scene *s, size_t b, sph_status st,
+                             sph_error *err) {
+  char msg[768], key[32];
+  snprintf(msg, sizeof msg, "%s", err->message);
+  snprintf(key, sizeof key, "bodies[%zu]", b);
+  return sph_error_at(err, st, s->path, s->bodies[b].line, s->bodies[b].col,
+                      key, "%s", msg);
+}
+
+/* bodies A and B overlap: particles at Xa and Xb closer than dp / 2 */
+static sph_status overlap_error(const sph_scene *s, int32_t A, int32_t B,
+                                const double Xa[3], const double Xb[3],
+                                sph_error *err) {
+  const sph_body *later = &s->bodies[A > B ? A : B];
+  const sph_body *first = &s->bodies[A > B ? B : A];
+  char key[32];
+  snprintf(key, sizeof key, "bodies[%d]", (int)(later - s->bodies));
+  return sph_error_at(err, SPH_ERR_GEOMETRY, s->path, later->line, later->col,
+                      key,
+                      "body '%s' overlaps body '%s' (particles %.3g m "
+                      "apart)",
+                      later->name, first->name,
+                      sqrt(pow(Xa[0] - Xb[0], 2) + pow(Xa[1] - Xb[1], 2) +
+                           pow(Xa[2] - Xb[2], 2)));
+}
+
+/* the first of the n points X (bodies, in creation order) that `check`
+ * marks with a point of another body closer than dp / 2, and the first
+ * such point: as an error, *first its index (n: none) */
+static sph_status find_overlap(const sph_scene *s, const double *X,
+                               const int32_t *body, const char *check, size_t n,
+                               size_t *first, sph_error *err) {
+  *first = n;
   sph_neighbors *nl;
   SPH_TRY(sph_neighbors_create(&nl, err));
-  sph_status st = sph_neighbors_build(
-      nl, ps->field[SPH_FIELD_POSITION0], ps->n, s->dimension,
-      0.5 * sph_scene_min_spacing(s), NULL, SPH_PAIRS_ALL, err);
-  for (size_t a = 0; st == SPH_OK && a < ps->n; ++a)
-    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+  sph_status st = sph_neighbors_build(nl, X, n, s->dimension,
+                                      0.5 * sph_scene_min_spacing(s), NULL,
+                                      SPH_PAIRS_ALL, err);
+  for (size_t a = 0; st == SPH_OK && a < n; ++a)
+    for (size_t k = nl->offset[a];
+         (!check || check[a]) && k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
-      if (ps->body[b] == ps->body[a])
+      if (body[b] == body[a])
         continue;
-      const sph_body *A = &s->bodies[ps->body[a]], *B = &s->bodies[ps->body[b]];
-      const sph_body *later = ps->body[a] > ps->body[b] ? A : B;
-      const sph_body *first = later == A ? B : A;
-      char key[32];
-      snprintf(key, sizeof key, "bodies[%d]", (int)(later - s->bodies));
-      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, later->line, later->col,
-                        key,
-                        "body '%s' overlaps body '%s' (particles %.3g m "
-                        "apart)",
-                        later->name, first->name,
-                        sqrt(pow(ps->field[SPH_FIELD_POSITION0][3 * a] -
-                                     ps->field[SPH_FIELD_POSITION0][3 * b],
-                                 2) +
-                             pow(ps->field[SPH_FIELD_POSITION0][3 * a + 1] -
-                                     ps->field[SPH_FIELD_POSITION0][3 * b + 1],
-                                 2) +
-                             pow(ps->field[SPH_FIELD_POSITION0][3 * a + 2] -
-                                     ps->field[SPH_FIELD_POSITION0][3 * b + 2],
-                                 2)));
+      *first = a;
+      st = overlap_error(s, body[a], body[b], X + 3 * a, X + 3 * b, err);
       break;
     }
   sph_neighbors_destroy(nl);
   return st;
 }
 
-/* Positions a double can tell apart at the particle spacing: beyond 1e9
- * spacings from the origin a coordinate's rounding step exceeds 1e-7 dp
- * (kernel sums and neighbour cells lose their meaning). */
-static sph_status check_resolvable(const sph_scene *s, const sph_particles *ps,
-                                   sph_error *err) {
-  const double *X = ps->field[SPH_FIELD_POSITION0];
-  double limit = 1e9 * sph_scene_min_spacing(s);
-  for (size_t i = 0; i < ps->n; ++i)
-    for (int c = 0; c < 3; ++c)
-      if (!(fabs(X[3 * i + c]) <= limit)) {
-        const sph_body *bd = &s->bodies[ps->body[i]];
-        char key[32];
-        snprintf(key, sizeof key, "bodies[%d]", (int)ps->body[i]);
-        return sph_error_at(
-            err, SPH_ERR_GEOMETRY, s->path, bd->line, bd->col, key,
-            "a particle at %g m lies more than 1e9 particle spacings (%g m) "
-            "from the origin, where double precision cannot resolve the "
-            "spacing: place the body nearer the origin",
-            X[3 * i + c], sph_scene_min_spacing(s));
-      }
-  return SPH_OK;
+static sph_status check_overlap(const sph_scene *s, sph_particles *ps,
+                                sph_error *err) {
+  if (s->nbodies < 2)
+    return SPH_OK;
+  size_t first;
+  return find_overlap(s, ps->field[SPH_FIELD_POSITION0], ps->body, NULL, ps->n,
+                      &first, err);
 }
 
 sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
@@ -1506,18 +1652,15 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
   double **xs = calloc(s->nbodies, sizeof *xs);
   double **vs = calloc(s->nbodies, sizeof *vs);
   size_t *ns = calloc(s->nbodies, sizeof *ns), total = 0;
-  sph_status st =
-      xs && vs && ns ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "bodies");
+  build_checks c;
+  sph_status st = checks_create(s, &c, err);
+  if (st == SPH_OK && !(xs && vs && ns))
+    st = sph_error_set(err, SPH_ERR_NOMEM, "bodies");
   for (size_t b = 0; st == SPH_OK && b < s->nbodies; ++b) {
     st = sph_body_generate(&s->bodies[b], s->dimension, &xs[b], &vs[b], &ns[b],
                            err);
-    if (st != SPH_OK) {
-      char msg[768], key[32];
-      snprintf(msg, sizeof msg, "%s", err->message);
-      snprintf(key, sizeof key, "bodies[%zu]", b);
-      st = sph_error_at(err, st, s->path, s->bodies[b].line, s->bodies[b].col,
-                        key, "%s", msg);
-    }
+    if (st != SPH_OK)
+      st = body_error(s, b, st, err);
     total += ns[b];
   }
   sph_particles *ps = NULL;
@@ -1528,26 +1671,14 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
   /* positions and initial velocities from the body frame to the world */
   for (size_t b = 0; st == SPH_OK && b < s->nbodies; ++b)
     for (size_t i = 0; st == SPH_OK && i < ns[b]; ++i) {
-      const sph_body *bd = &s->bodies[b];
-      double X[3], vb[3];
-      sph_body_world(bd, xs[b] + 3 * i, X);
+      double X[3], v[3];
+      uint32_t flags;
+      particle_state(s, b, xs[b] + 3 * i, X, v, &flags, &c);
       st = sph_particles_append(ps, X, vs[b][i], (int32_t)b, err);
-      if (st != SPH_OK)
-        break;
-      double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1);
-      initial_velocity(&bd->velocity, xs[b] + 3 * i, vb);
-      if (!isfinite(vb[0] + vb[1] + vb[2])) {
-        char key[48];
-        snprintf(key, sizeof key, "bodies[%zu].initial_velocity", b);
-        st = sph_error_at(err, SPH_ERR_RANGE, s->path, bd->line, bd->col, key,
-                          "not finite at (%g, %g, %g) (body frame)",
-                          xs[b][3 * i], xs[b][3 * i + 1], xs[b][3 * i + 2]);
-        break;
+      if (st == SPH_OK) {
+        memcpy(ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1), v, sizeof v);
+        ps->flags[ps->n - 1] = flags;
       }
-      if (bd->transform.given)
-        rotate(&bd->transform, vb, v);
-      else
-        memcpy(v, vb, sizeof vb);
     }
   for (size_t b = 0; xs && vs && b < s->nbodies; ++b) {
     free(xs[b]);
@@ -1557,69 +1688,273 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
   free(vs);
   free(ns);
   if (st == SPH_OK)
-    st = check_resolvable(s, ps, err);
+    st = checks_first(&c, err);
   if (st == SPH_OK)
     st = check_overlap(s, ps, err);
-  /* boundary selections */
-  for (size_t k = 0; st == SPH_OK && k < s->nboundaries; ++k) {
-    const sph_boundary *bc = &s->boundaries[k];
-    size_t hits = 0;
-    for (size_t i = 0; i < ps->n; ++i)
-      if (sph_selection_contains(s, &bc->select, ps->body[i],
-                                 ps->field[SPH_FIELD_POSITION0] + 3 * i)) {
-        ps->flags[i] |= SPH_FLAG_BOUNDARY;
-        ++hits;
-      }
-    if (!hits) {
-      char key[48];
-      snprintf(key, sizeof key, "boundaries[%zu].select", k);
-      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, bc->line, bc->col, key,
-                        "boundary '%s' selects no particle", bc->name);
-    }
-  }
-  /* probes: within one spacing of a particle */
-  for (size_t k = 0; st == SPH_OK && k < s->output.nprobes; ++k) {
-    const sph_probe *p = &s->output.probes[k];
-    int inside = 0;
-    for (size_t i = 0; i < ps->n && !inside; ++i) {
-      const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * i;
-      double d2 = 0.0;
-      for (int c = 0; c < s->dimension; ++c)
-        d2 += (X[c] - p->at[c]) * (X[c] - p->at[c]);
-      double h = s->bodies[ps->body[i]].spacing;
-      inside = d2 <= h * h;
-    }
-    if (!inside) {
-      char key[48];
-      snprintf(key, sizeof key, "output.probes[%zu].at", k);
-      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, p->line, p->col, key,
-                        "probe '%s' at (%g, %g, %g) is outside every body",
-                        p->name, p->at[0], p->at[1],
-                        s->dimension == 3 ? p->at[2] : 0.0);
-    }
-  }
-  /* walls: no particle starts behind one */
-  for (size_t k = 0; st == SPH_OK && k < s->contact.nwalls; ++k) {
-    const sph_wall *w = &s->contact.walls[k];
-    for (size_t i = 0; i < ps->n; ++i) {
-      double nrm[3],
-          g = sph_wall_distance(w, 0.0, s->dimension,
-                                ps->field[SPH_FIELD_POSITION0] + 3 * i, nrm);
-      if (g >= 0.0)
-        continue;
-      char key[48];
-      snprintf(key, sizeof key, "contact.walls[%zu]", k);
-      st = sph_error_at(err, SPH_ERR_GEOMETRY, s->path, w->line, w->col, key,
-                        "body '%s' starts inside wall '%s' (a particle %g m "
-                        "beyond it)",
-                        s->bodies[ps->body[i]].name, w->name, -g);
-      break;
-    }
-  }
+  if (st == SPH_OK)
+    st = checks_rest(s, &c, err);
+  checks_destroy(&c);
   if (st != SPH_OK) {
     sph_particles_destroy(ps);
     return st;
   }
   *out = ps;
+  return SPH_OK;
+}
+
+/* ---- one rank's share, without the whole set ------------------------------
+ */
+
+/* the passes of sph_scene_build_share over every particle in creation order */
+typedef struct share_pass {
+  const sph_scene *s;
+  int pass;       /* 1: bounds and checks, 2: count per cell, 3: keep */
+  size_t b;       /* the body visited */
+  int64_t id;     /* creation index of the next particle */
+  build_checks c; /* pass 1 */
+  double lo[3], hi[3], cell;
+  size_t nc[3];  /* cells per axis */
+  int64_t *grid; /* pass 2: particles per cell; pass 3: next storage index */
+  int64_t first, last; /* storage indices kept: [first, last) */
+  sph_particles *ps;
+  int64_t *gidx;
+  /* several bodies: the share's particles and those of the cells next to
+   * its cells (the overlap check's neighbours), in creation order */
+  char *mine; /* per cell: holds a particle of the share */
+  double *nx;
+  int32_t *nbody;
+  int64_t *nid;
+  char *nin; /* in the share */
+  size_t nn, ncap;
+} share_pass;
+
+/* whether a cell next to q (or q) holds a particle of the share */
+static int near_share(const share_pass *p, const uint32_t q[3]) {
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k) {
+        long c[3] = {(long)q[0] + i, (long)q[1] + j, (long)q[2] + k};
+        int in = 1;
+        for (int e = 0; e < 3; ++e)
+          in &= c[e] >= 0 && c[e] < (long)p->nc[e];
+        if (in && p->mine[((size_t)c[2] * p->nc[1] + (size_t)c[1]) * p->nc[0] +
+                          (size_t)c[0]])
+          return 1;
+      }
+  return 0;
+}
+
+/* a point of the overlap check */
+static sph_status keep_near(share_pass *p, const double X[3], int64_t id,
+                            int in, sph_error *err) {
+  if (p->nn == p->ncap) {
+    size_t c = p->ncap ? 2 * p->ncap : 1024;
+    double *x = realloc(p->nx, 3 * c * sizeof *x);
+    if (x)
+      p->nx = x;
+    int32_t *b = realloc(p->nbody, c * sizeof *b);
+    if (b)
+      p->nbody = b;
+    int64_t *i = realloc(p->nid, c * sizeof *i);
+    if (i)
+      p->nid = i;
+    char *n = realloc(p->nin, c);
+    if (n)
+      p->nin = n;
+    if (!x || !b || !i || !n)
+      return sph_error_set(err, SPH_ERR_NOMEM, "overlap check");
+    p->ncap = c;
+  }
+  memcpy(p->nx + 3 * p->nn, X, 3 * sizeof *X);
+  p->nbody[p->nn] = (int32_t)p->b;
+  p->nid[p->nn] = id;
+  p->nin[p->nn++] = (char)in;
+  return SPH_OK;
+}
+
+typedef struct share_cell {
+  uint64_t key;
+  size_t cell;
+} share_cell;
+
+static int cmp_share_cell(const void *pa, const void *pb) {
+  const share_cell *a = pa, *b = pb;
+  return (a->key > b->key) - (a->key < b->key);
+}
+
+static sph_status share_point(void *ctx, const double Xb[3], double volume,
+                              sph_error *err) {
+  share_pass *p = ctx;
+  const sph_scene *s = p->s;
+  double X[3], v[3];
+  uint32_t flags, q[3];
+  int64_t id = p->id++;
+  if (p->pass == 1) {
+    particle_state(s, p->b, Xb, X, v, &flags, &p->c);
+    for (int c = 0; c < 3; ++c) {
+      p->lo[c] = fmin(p->lo[c], X[c]);
+      p->hi[c] = fmax(p->hi[c], X[c]);
+    }
+    return SPH_OK;
+  }
+  sph_body_world(&s->bodies[p->b], Xb, X);
+  sph_morton_cell(X, p->lo, p->cell, q);
+  size_t cell = ((size_t)q[2] * p->nc[1] + q[1]) * p->nc[0] + q[0];
+  if (p->pass == 2) {
+    p->grid[cell]++;
+    return SPH_OK;
+  }
+  /* particles of one cell in creation order: the sort's tie-break */
+  int64_t g = p->grid[cell]++;
+  int in = g >= p->first && g < p->last;
+  if (p->mine && (in || near_share(p, q)))
+    SPH_TRY(keep_near(p, X, id, in, err));
+  if (!in)
+    return SPH_OK;
+  sph_particles *ps = p->ps;
+  particle_state(s, p->b, Xb, X, v, &flags, NULL);
+  SPH_TRY(sph_particles_append(ps, X, volume, (int32_t)p->b, err));
+  memcpy(ps->field[SPH_FIELD_VELOCITY] + 3 * (ps->n - 1), v, sizeof v);
+  ps->flags[ps->n - 1] = flags;
+  ps->id[ps->n - 1] = id;
+  p->gidx[ps->n - 1] = g;
+  return SPH_OK;
+}
+
+/* one pass over every body's particles */
+static sph_status share_visit(share_pass *p, int pass, sph_error *err) {
+  p->pass = pass;
+  p->id = 0;
+  for (p->b = 0; p->b < p->s->nbodies; ++p->b) {
+    size_t n;
+    sph_status st = sph_body_visit(&p->s->bodies[p->b], p->s->dimension,
+                                   share_point, p, &n, err);
+    if (st != SPH_OK)
+      return body_error(p->s, p->b, st, err);
+  }
+  return SPH_OK;
+}
+
+/* grid[cell] = the storage index of the cell's first particle: the
+ * occupied cells in Morton order */
+static sph_status share_starts(share_pass *p, size_t cells, sph_error *err) {
+  size_t m = 0;
+  for (size_t k = 0; k < cells; ++k)
+    m += p->grid[k] > 0;
+  share_cell *occ = malloc((m ? m : 1) * sizeof *occ);
+  if (!occ)
+    return sph_error_set(err, SPH_ERR_NOMEM, "particle order (%zu cells)", m);
+  m = 0;
+  for (size_t k = 0; k < cells; ++k)
+    if (p->grid[k] > 0) {
+      uint32_t q[3] = {(uint32_t)(k % p->nc[0]),
+                       (uint32_t)(k / p->nc[0] % p->nc[1]),
+                       (uint32_t)(k / p->nc[0] / p->nc[1])};
+      occ[m++] = (share_cell){sph_morton_key(q), k};
+    }
+  qsort(occ, m, sizeof *occ, cmp_share_cell);
+  int64_t start = 0;
+  for (size_t j = 0; j < m; ++j) {
+    int64_t count = p->grid[occ[j].cell];
+    p->grid[occ[j].cell] = start;
+    if (p->mine)
+      p->mine[occ[j].cell] = start < p->last && start + count > p->first;
+    start += count;
+  }
+  free(occ);
+  return SPH_OK;
+}
+
+sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
+                                 int size, sph_particles **out, int64_t **gidx,
+                                 size_t *total, int64_t *overlap,
+                                 sph_error *err) {
+  *out = NULL;
+  *gidx = NULL;
+  *total = 0;
+  *overlap = INT64_MAX;
+  share_pass p = {.s = s,
+                  .cell = cell,
+                  .lo = {INFINITY, INFINITY, INFINITY},
+                  .hi = {-INFINITY, -INFINITY, -INFINITY}};
+  /* pass 1: the bounds and the checks, as the whole set's */
+  sph_status st = checks_create(s, &p.c, err);
+  if (st == SPH_OK)
+    st = share_visit(&p, 1, err);
+  size_t N = (size_t)p.id;
+  if (st == SPH_OK)
+    st = checks_first(&p.c, err);
+  /* the later checks' error comes after the overlap check's */
+  sph_error later;
+  sph_status rest = st == SPH_OK ? checks_rest(s, &p.c, &later) : SPH_OK;
+  checks_destroy(&p.c);
+  int several = s->nbodies > 1;
+  if (st == SPH_OK && rest != SPH_OK && !several)
+    *err = later, st = rest;
+  if (st != SPH_OK)
+    return st;
+  /* the cell grid of the Morton order; a sparse one (far apart bodies)
+   * larger than 2 cells a particle and 2^22 cells, or for the overlap check
+   * cells clamped or smaller than its dp / 2: the whole set instead */
+  double cells = 1.0;
+  int clamped = 0;
+  for (int c = 0; c < 3; ++c) {
+    double q = floor((p.hi[c] - p.lo[c]) / cell);
+    clamped |= q > 2097151.0;
+    p.nc[c] = (size_t)fmin(q, 2097151.0) + 1;
+    cells *= (double)p.nc[c];
+  }
+  if (!(cell > 0.0) || cells > fmax(2.0 * (double)N, 4194304.0) ||
+      (several && (clamped || 0.5 * sph_scene_min_spacing(s) > cell)))
+    return SPH_OK;
+  p.grid = calloc((size_t)cells, sizeof *p.grid);
+  if (several)
+    p.mine = calloc((size_t)cells, 1);
+  if (!p.grid || (several && !p.mine)) {
+    free(p.grid);
+    free(p.mine);
+    return sph_error_set(err, SPH_ERR_NOMEM, "particle order (%.3g cells)",
+                         cells);
+  }
+  /* pass 2: particles per cell; pass 3: storage indices, keeping the
+   * share [rank N / size, (rank + 1) N / size) */
+  p.first = (int64_t)(N * (size_t)rank / (size_t)size);
+  p.last = (int64_t)(N * ((size_t)rank + 1) / (size_t)size);
+  size_t m = (size_t)(p.last - p.first);
+  st = share_visit(&p, 2, err);
+  if (st == SPH_OK)
+    st = share_starts(&p, (size_t)cells, err);
+  if (st == SPH_OK)
+    st = sph_particles_create(&p.ps, m, s->dimension, err);
+  if (st == SPH_OK)
+    st = sph_particles_require(p.ps, SPH_FIELD_VELOCITY, err);
+  if (st == SPH_OK && !(p.gidx = malloc((m ? m : 1) * sizeof *p.gidx)))
+    st = sph_error_set(err, SPH_ERR_NOMEM, "particle share (%zu)", m);
+  if (st == SPH_OK)
+    st = share_visit(&p, 3, err);
+  free(p.grid);
+  free(p.mine);
+  /* bodies that overlap: the share's first particle with a neighbour of
+   * another body closer than dp / 2 (its neighbours are in the share or
+   * the cells next to its cells) */
+  size_t bad = p.nn;
+  if (st == SPH_OK && several)
+    st = find_overlap(s, p.nx, p.nbody, p.nin, p.nn, &bad, err);
+  if (bad < p.nn)
+    *overlap = p.nid[bad];
+  if (st == SPH_OK && rest != SPH_OK)
+    *err = later, st = rest;
+  free(p.nx);
+  free(p.nbody);
+  free(p.nid);
+  free(p.nin);
+  if (st != SPH_OK) {
+    sph_particles_destroy(p.ps);
+    free(p.gidx);
+    return st;
+  }
+  *out = p.ps;
+  *gidx = p.gidx;
+  *total = N;
   return SPH_OK;
 }

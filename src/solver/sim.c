@@ -3,6 +3,7 @@
  * 4). The loop calls method->stable_dt and method->step once per step. */
 #include "sph/sim.h"
 
+#include "sph/domain.h"
 #include "sph/geometry.h"
 #include "sph/reference.h"
 #include "sph/tensor.h"
@@ -88,7 +89,9 @@ static sph_status check_memory(const sph_scene *scene, double support,
     n += k;
   }
   double r = support / dp, nb = dim == 3 ? 4.19 * r * r * r : 3.14 * r * r;
-  double need = n * (1000.0 + 24.0 * nb);
+  /* over ranks: the share of the ranks on this node */
+  int ranks = sph_domain_world_size(), here = sph_domain_node_size();
+  double need = n * (1000.0 + 24.0 * nb) * here / ranks;
   double avail = 0.0;
   FILE *f = fopen("/proc/meminfo", "r");
   char line[128];
@@ -104,22 +107,28 @@ static sph_status check_memory(const sph_scene *scene, double support,
   if (by_limit ? need <= limit : !(avail > 0.0) || need <= 0.9 * avail)
     return SPH_OK;
   const sph_node *bodies = sph_node_child(scene->root, "bodies");
+  char share[96] = "";
+  if (ranks > 1)
+    snprintf(share, sizeof share, " (%d of the %d ranks on this node)", here,
+             ranks);
   if (by_limit)
     return sph_node_error(bodies ? bodies : scene->root, err, SPH_ERR_RANGE,
-                          "about %.3g particles need about %.3g GB; the limit "
-                          "(--max-memory) is %.3g GB: fewer particles (a "
-                          "larger spacing or count)",
-                          n, need / 1e9, limit / 1e9);
+                          "about %.3g particles need about %.3g GB%s; the "
+                          "limit (--max-memory) is %.3g GB: fewer particles "
+                          "(a larger spacing or count)",
+                          n, need / 1e9, share, limit / 1e9);
   return sph_node_error(
       bodies ? bodies : scene->root, err, SPH_ERR_RANGE,
-      "about %.3g particles need about %.1f GB; %.1f GB of memory is "
+      "about %.3g particles need about %.1f GB%s; %.1f GB of memory is "
       "available: fewer particles (a larger spacing or count)",
-      n, need / 1e9, avail / 1e9);
+      n, need / 1e9, share, avail / 1e9);
 }
 
 /* A distributed run (more than one MPI rank) of what runs distributed so
- * far: refused, the same on every rank, before anything is written. */
-static sph_status distribute(sph_sim *sim, sph_error *err) {
+ * far: refused, the same on every rank, before anything is written; from
+ * each rank's share (gidx: its storage indices, of N) or the whole set. */
+static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
+                             sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_node *bcs = sph_node_child(s->root, "boundaries");
   if (!sim->method->distributed) {
@@ -160,6 +169,9 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
                                       sim->kernel.support, err));
     return sph_domain_dyn_mirror(sim->domain, planes, np, 3.0, err);
   }
+  if (gidx)
+    return sph_domain_create_share(&sim->domain, &sim->ps, gidx, N,
+                                   sim->kernel.support, err);
   if (np)
     return sph_domain_create_mirrored(&sim->domain, &sim->ps,
                                       sim->kernel.support, planes, np, err);
@@ -167,6 +179,24 @@ static sph_status distribute(sph_sim *sim, sph_error *err) {
     return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
   return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,
                                    err);
+}
+
+/* Whether each rank can build its own share of the particles without the
+ * whole set (sph_scene_build_share): a fixed domain without symmetry planes
+ * (their mirror ghosts and the dynamic domain's cut tree come from the
+ * whole set), bodies of lattice or jitter points (a relaxation moves the
+ * whole body). */
+static int per_rank_setup(const sph_scene *s, const sph_method_ops *method) {
+  if (sph_domain_world_size() < 2 || method->distributed != 1)
+    return 0;
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY)
+      return 0;
+  for (size_t b = 0; b < s->nbodies; ++b)
+    if (s->bodies[b].distribution == SPH_DIST_RELAX)
+      return 0;
+  return 1;
 }
 
 /* Every term a distributed method creates must run on owned particles. */
@@ -218,16 +248,31 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                         scene->h_over_dp * sim->dp, err);
   if (st == SPH_OK)
     st = check_memory(scene, sim->kernel.support, sim->dp, err);
-  if (st == SPH_OK)
+  /* over MPI ranks: this rank's share of the particles, in the order below */
+  int64_t *gidx = NULL, first = INT64_MAX;
+  size_t N = 0;
+  if (st == SPH_OK && per_rank_setup(scene, method))
+    st = sph_scene_build_share(scene, sim->kernel.support,
+                               sph_domain_world_rank(), sph_domain_world_size(),
+                               &sim->ps, &gidx, &N, &first, err);
+  /* a rank's error about its particles: the one of the lowest creation
+   * index, the whole set's */
+  st = sph_domain_world_first(st, first, err);
+  if (st == SPH_OK && !sim->ps)
     st = sph_scene_build_particles(scene, &sim->ps, err);
   /* neighbours near in memory: cells of one kernel support in Morton order */
-  if (st == SPH_OK)
+  if (st == SPH_OK && !gidx)
     st = sph_particles_sort_morton(sim->ps, sim->kernel.support, err);
+  st = sph_domain_world_agree(st, err);
   if (st == SPH_OK)
     st = sph_reference_create(&sim->reference, scene, err);
   /* over MPI ranks: this rank's owned particles from here on */
   if (st == SPH_OK && sph_domain_world_size() > 1)
-    st = distribute(sim, err);
+    st = distribute(sim, gidx, N, err);
+  free(gidx);
+  /* rank 0's whole set for its outputs */
+  if (st == SPH_OK)
+    st = sph_domain_whole_create(sim->domain, sim->ps, err);
   if (st == SPH_OK && sim->reference)
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)

@@ -10,6 +10,17 @@
 
 #include "sph/scene.h"
 
+/* name, dimension, method, one material "m" and the start of the bodies */
+#define SPH_TEST_SCENE_HEAD(dim)                                               \
+  "name: t\n"                                                                  \
+  "dimension: " #dim "\n"                                                      \
+  "method: {name: tl-jst}\n"                                                   \
+  "materials:\n"                                                               \
+  "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "             \
+  "poisson_ratio: 0.3}\n"                                                      \
+  "time: {end: 0.1}\n"                                                         \
+  "bodies:\n"
+
 /* Loads `text` (the file is removed again) and asserts that it loads. */
 static inline sph_scene *sph_test_scene_text(const char *text) {
   char path[64] = "/tmp/sph_test_XXXXXX";

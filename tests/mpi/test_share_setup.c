@@ -1,0 +1,161 @@
+/* The per-rank set-up (sph_scene_build_share, sph_domain_create_share,
+ * issue 20) against the whole set's (sph_scene_build_particles,
+ * sph_particles_sort_morton, sph_domain_create): on every rank the same
+ * owned particles (fields, ids, bodies, flags bit for bit), storage
+ * indices, ghosts (positions, volumes, bodies, ids, in the same order) and
+ * halo plan, and rank 0's whole set (sph_domain_whole_create) the sorted
+ * whole set. 3D face lattice with jitter (a turned column), 2D cells with
+ * jitter, two 3D bodies (a block and a punch). Run under mpirun (ctest: 2, 3
+ * and 4 ranks). */
+#include "parallel/domain_impl.h"
+
+#include <check.h>
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sph/scene.h"
+#include "test_scene_util.h"
+
+#define SAME(a, b, n) (memcmp((a), (b), (n) * sizeof *(a)) == 0)
+
+/* the two particle sets' first n particles: equal bit for bit */
+static int same_set(const sph_particles *a, const sph_particles *b) {
+  static const sph_field f[] = {SPH_FIELD_POSITION0, SPH_FIELD_VOLUME0,
+                                SPH_FIELD_VELOCITY};
+  int ok = a->n == b->n;
+  for (size_t k = 0; ok && k < sizeof f / sizeof *f; ++k)
+    ok = a->field[f[k]] && b->field[f[k]] &&
+         SAME(a->field[f[k]], b->field[f[k]],
+              a->n * (size_t)sph_field_components(f[k]));
+  return ok && SAME(a->id, b->id, a->n) && SAME(a->body, b->body, a->n) &&
+         SAME(a->flags, b->flags, a->n);
+}
+
+/* ranks where the two set-ups differ */
+static int differences(const char *text, double support) {
+  sph_scene *s = sph_test_scene_text(text);
+  sph_error err;
+  sph_particles *whole = NULL, *share = NULL;
+  int64_t *gidx = NULL, first;
+  size_t N = 0;
+  ck_assert_int_eq(sph_scene_build_particles(s, &whole, &err), SPH_OK);
+  ck_assert_int_eq(sph_particles_sort_morton(whole, support, &err), SPH_OK);
+  ck_assert_int_eq(sph_scene_build_share(s, support, sph_domain_world_rank(),
+                                         sph_domain_world_size(), &share, &gidx,
+                                         &N, &first, &err),
+                   SPH_OK);
+  ck_assert_ptr_nonnull(share);
+  sph_particles *sorted = NULL; /* rank 0's whole set to compare */
+  ck_assert_int_eq(sph_particles_create(&sorted, whole->n, whole->dim, &err),
+                   SPH_OK);
+  ck_assert_int_eq(sph_particles_require(sorted, SPH_FIELD_VELOCITY, &err),
+                   SPH_OK);
+  sorted->n = whole->n;
+  memcpy(sorted->field[SPH_FIELD_POSITION0], whole->field[SPH_FIELD_POSITION0],
+         3 * whole->n * sizeof(double));
+  memcpy(sorted->field[SPH_FIELD_VOLUME0], whole->field[SPH_FIELD_VOLUME0],
+         whole->n * sizeof(double));
+  memcpy(sorted->field[SPH_FIELD_VELOCITY], whole->field[SPH_FIELD_VELOCITY],
+         3 * whole->n * sizeof(double));
+  memcpy(sorted->id, whole->id, whole->n * sizeof *whole->id);
+  memcpy(sorted->body, whole->body, whole->n * sizeof *whole->body);
+  memcpy(sorted->flags, whole->flags, whole->n * sizeof *whole->flags);
+  sph_domain *a = NULL, *b = NULL;
+  ck_assert_int_eq(sph_domain_create(&a, &whole, support, &err), SPH_OK);
+  ck_assert_int_eq(sph_domain_create_share(&b, &share, gidx, N, support, &err),
+                   SPH_OK);
+  ck_assert_int_eq(sph_domain_whole_create(b, share, &err), SPH_OK);
+  int bad = a->n != b->n || a->ng != b->ng || a->nsend != b->nsend ||
+            !same_set(whole, share);
+  if (!bad) {
+    size_t ng = a->ng;
+    bad = !SAME(a->gidx, b->gidx, a->n + ng) || !SAME(a->gX, b->gX, 3 * ng) ||
+          !SAME(a->gV, b->gV, ng) || !SAME(a->gbody, b->gbody, ng) ||
+          !SAME(a->gid, b->gid, ng) ||
+          !SAME(a->recv_count, b->recv_count, (size_t)a->size) ||
+          !SAME(a->send_count, b->send_count, (size_t)a->size) ||
+          !SAME(a->send_idx, b->send_idx, a->nsend);
+  }
+  if (!bad && a->rank == 0) {
+    bad = !b->all || !same_set(sorted, b->all);
+    for (size_t i = 0; !bad && i < b->all->n; ++i)
+      bad = b->all->slot[b->all->id[i]] != (int64_t)i;
+  }
+  int all = 0;
+  MPI_Allreduce(&bad, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  sph_domain_destroy(a);
+  sph_domain_destroy(b);
+  sph_particles_destroy(whole);
+  sph_particles_destroy(share);
+  sph_particles_destroy(sorted);
+  free(gidx);
+  sph_scene_destroy(s);
+  return all;
+}
+
+START_TEST(column_3d) {
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      3) "  - name: column\n"
+         "    material: m\n"
+         "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 6, 0.5]}}\n"
+         "    particles: {count: [7, 37, 6], distribution: jitter, "
+         "jitter: 0.3, seed: 7}\n"
+         "    transform: {rotate: {axis: [1, 1, 0], angle: 20}}\n"
+         "    initial_velocity: {rotation: {axis: y, omega: 105}}\n"
+         "boundaries:\n"
+         "  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: "
+         "true}\n";
+  /* the support of h = 1.3 dp, wendland: 2.6 dp */
+  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0), 0);
+}
+END_TEST
+
+START_TEST(ring_2d) {
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      2) "  - name: ring\n"
+         "    material: m\n"
+         "    shape: {ring: {center: [-1, 1], inner_radius: 0.2, "
+         "outer_radius: 0.35}}\n"
+         "    particles: {spacing: 0.01, distribution: jitter, seed: 5}\n"
+         "    initial_velocity: {uniform: [1, 0, 0]}\n";
+  ck_assert_int_eq(differences(scene, 0.026), 0);
+}
+END_TEST
+
+START_TEST(bodies_3d) {
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      3) "  - name: block\n"
+         "    material: m\n"
+         "    shape: {box: {min: [-1, -0.4, -1], max: [1, 0, 1]}}\n"
+         "    particles: {count: [21, 5, 21]}\n"
+         "  - name: punch\n"
+         "    material: m\n"
+         "    shape: {cylinder: {center: [0, 0.05, 0], axis: y, radius: "
+         "0.3, length: 0.5}}\n"
+         "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
+         "    initial_velocity: {uniform: [0, -1, 0]}\n";
+  ck_assert_int_eq(differences(scene, 0.26), 0);
+}
+END_TEST
+
+int main(int argc, char **argv) {
+  sph_error err;
+  if (sph_domain_init(&argc, &argv, &err) != SPH_OK)
+    return 1;
+  Suite *s = suite_create("share_setup");
+  TCase *t = tcase_create("share_setup");
+  tcase_set_timeout(t, 300);
+  tcase_add_test(t, column_3d);
+  tcase_add_test(t, ring_2d);
+  tcase_add_test(t, bodies_3d);
+  suite_add_tcase(s, t);
+  SRunner *sr = srunner_create(s);
+  srunner_set_fork_status(sr, CK_NOFORK); /* one MPI process a rank */
+  srunner_run_all(sr, sph_domain_world_rank() == 0 ? CK_NORMAL : CK_SILENT);
+  int failed = srunner_ntests_failed(sr);
+  srunner_free(sr);
+  sph_domain_finalize();
+  return failed == 0 ? 0 : 1;
+}
