@@ -138,6 +138,12 @@ void sph_app_print_error(const sph_error *err);
 int sph_app_load(const sph_app_args *args, const char *path,
                  struct sph_scene **scene, struct sph_sim **sim);
 
+/* Whether a run of scene s over MPI ranks needs rank 0 to hold a whole view
+ * of the particles (gathered at each frame): the PNG frames, the probes or
+ * a reference read one; the verdict, momenta and counts do not. */
+struct sph_scene;
+int sph_run_needs_whole_view(const struct sph_scene *s);
+
 int sph_cmd_run(int argc, char **argv);
 int sph_cmd_check(int argc, char **argv);
 int sph_cmd_list(int argc, char **argv);
