@@ -152,6 +152,31 @@ void sph_domain_traffic(const sph_domain *d, double *values, double *messages);
  * domain state (sph_domain_checkpoint). */
 int sph_domain_migrates(const sph_domain *d);
 
+/* The particles of the whole run: over all ranks, ps->n for NULL. */
+size_t sph_domain_particles(const sph_domain *d, const sph_particles *ps);
+/* Rank 0 frees its whole set and the gather's buffers: a run whose outputs
+ * read no whole view (sph_domain_gather must not be called after). */
+void sph_domain_drop_global(sph_domain *d);
+/* The other ranks' points (ncomp doubles each, the first 3 the position)
+ * within `radius` of this rank's box of its n points pts, received into
+ * *out (grown to *cap doubles when short) by rank, *m of them
+ * (collective; *m = 0 for NULL). */
+sph_status sph_domain_box_points(sph_domain *d, const double *pts, size_t n,
+                                 int ncomp, double radius, double **out,
+                                 size_t *cap, size_t *m, sph_error *err);
+/* The ncomp values of the particles with the storage indices want[0 ..
+ * nwant) into out, answered by their owners (collective: every rank's
+ * requests are gathered; each passes its n owned particles' storage
+ * indices key in ascending order and their values val); 0 for an index
+ * no rank owns. */
+sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
+                            const int64_t *key, const double *val, size_t n,
+                            int ncomp, double *out, sph_error *err);
+/* Rank 0 receives into out, for each of m rows of w doubles, the row of
+ * the lowest rank whose row k starts with a non-zero flag (flag included;
+ * rows of no rank are left; collective; nothing for NULL). */
+sph_status sph_domain_pick(sph_domain *d, const double *rows, size_t m, int w,
+                           double *out, sph_error *err);
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
 sph_particles *sph_domain_global(const sph_domain *d);
 /* Gathers the fields of `local` among those selected (every field until

@@ -16,6 +16,9 @@ typedef struct sph_frame {
   const sph_sim *sim;
   const sph_particles *ps;
   double kinetic, strain; /* energies of this state */
+  /* linear then angular momentum (over MPI ranks: summed in rank order);
+   * NULL: sph_momentum of ps */
+  const double *momentum;
 } sph_frame;
 
 typedef struct sph_sink sph_sink;

@@ -56,7 +56,15 @@
  * Both work from positions, reference positions, body ids and von Mises
  * only, so they apply to every method; their lists are allocated at
  * creation (the current-configuration lists grow only when an output
- * frame needs more room) and cost O(N) per frame. */
+ * frame needs more room) and cost O(N) per frame.
+ * Over MPI ranks every rank judges its owned particles: the minima, maxima,
+ * counts and sums (in rank order) are reduced over the ranks; the zig-zag
+ * fit and the surface flags read the other ranks' particles within the
+ * zig-zag radius (two at creation) of the rank's box, exchanged at every
+ * frame, its neighbour lists sorted by storage index so each fit is the
+ * serial one bit for bit; a pair of the fracture list is judged by the rank
+ * that owned its first particle (by storage index) at creation, a partner
+ * beyond those points fetched from its owner by storage index. */
 #ifndef SPH_STABILITY_H
 #define SPH_STABILITY_H
 
@@ -115,11 +123,13 @@ typedef struct sph_verdict {
   double lin0[3], ang0[3], lin_scale, ang_scale;
   double lin_drift, ang_drift; /* largest relative drift seen */
   signed char *parity;         /* s_a = +-1, 0 without a lattice */
+  size_t parity_cap;
   int has_parity;
   /* numerical fracture: threshold in dp (0 = not judged), adjacent pairs */
   double fracture_dp;
-  size_t npairs;
-  int32_t *pairs;               /* 2 * npairs particle indices */
+  size_t npairs;                /* over all ranks */
+  size_t npairs_local;          /* the pairs this rank judges */
+  int64_t *pairs;               /* 2 * npairs_local storage indices */
   double fracture_max_stretch;  /* this frame: max |x_a - x_b| / dp */
   long fracture_pairs_over;     /* this frame: pairs beyond fracture_dp */
   double fracture_peak_stretch; /* largest over the frames */
@@ -134,29 +144,36 @@ typedef struct sph_verdict {
   double *body_dp;         /* spacing of every body */
   sph_kernel *body_kernel; /* Wendland C2 with h = 1.3 dp of every body */
   double zigzag_radius;    /* largest support */
-  /* particles R is judged on: those of bodies with an interior at least
-   * one support across (none when every body is too coarse) */
-  char *zigzag_judged;
+  /* bodies R is judged on: those with an interior at least one support
+   * across (none when every body is too coarse), and their particles */
+  char *body_judged;
   size_t zigzag_count;
   sph_neighbors *nl; /* current-configuration lists, reused */
   double *work;      /* n entries */
+  size_t work_cap;
+  /* over MPI ranks (NULL serially): each rank judges its owned particles
+   * with the other ranks' particles within the zig-zag radius of its box
+   * (points: position, von Mises, body, storage index), the indicators
+   * are reduced over the ranks */
+  sph_domain *dom;
+  double *pts, *near; /* owned packed, received */
+  size_t pts_cap, near_cap, nnear;
+  double *lx, *ls; /* owned then received: positions, von Mises */
+  int32_t *lbody;
+  int64_t *lkey; /* storage indices */
+  size_t local_cap;
+  int64_t *order; /* 2 per point: storage index, point; ascending */
+  size_t order_cap;
 } sph_verdict;
 
 sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
                               sph_error *err);
 void sph_verdict_destroy(sph_verdict *v);
 
-/* The fields the indicators and the momenta read besides the reference
- * positions and volumes (bit 1ul << f): over MPI ranks rank 0 gathers
- * these. */
-#define SPH_VERDICT_FIELDS                                                     \
-  (1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_VELOCITY |                     \
-   1ul << SPH_FIELD_STRESS | 1ul << SPH_FIELD_JACOBIAN |                       \
-   1ul << SPH_FIELD_MASS | 1ul << SPH_FIELD_PRESSURE |                         \
-   1ul << SPH_FIELD_VON_MISES)
-
 /* Updates the indicators from a frame (after method->derive); fails only
- * when the neighbour lists cannot grow. */
+ * when the neighbour lists cannot grow. Over MPI ranks (the frame's sim has
+ * a domain, its ps the owned particles) every rank calls it: the same
+ * verdict on all. */
 sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *frame,
                                sph_error *err);
 
@@ -174,6 +191,11 @@ void sph_verdict_fail_step(sph_verdict *v, double t, const sph_error *err);
 double sph_checkerboard_indicator(const signed char *parity,
                                   const double *volume, const double *f,
                                   size_t n);
+/* The same over MPI ranks, each passing its owned particles' values
+ * (sums added in rank order); d NULL: sph_checkerboard_indicator. */
+double sph_checkerboard_indicator_over(sph_domain *d, const signed char *parity,
+                                       const double *volume, const double *f,
+                                       size_t n);
 
 /* Lattice parity of every particle of a scene's bodies. */
 void sph_lattice_parity(const sph_scene *s, const sph_particles *ps,

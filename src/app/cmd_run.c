@@ -142,7 +142,8 @@ static void banner(const sph_sim *sim, const char *dir, const sph_halo *h) {
   printf("  method     %s: %s\n             [%s]\n", sim->method->name,
          sim->method->title, sim->method->reference);
   printf("  particles  %zu in %zu bod%s, dp = %.4g m, kernel %s h = %.4g m\n",
-         sim->ps->n, s->nbodies, s->nbodies == 1 ? "y" : "ies", sim->dp,
+         sph_domain_particles(sim->domain, sim->ps), s->nbodies,
+         s->nbodies == 1 ? "y" : "ies", sim->dp,
          sph_kernel_type_name(s->kernel_type), sim->kernel.h);
   printf("  terms     ");
   if (!sim->nterms)
@@ -202,16 +203,131 @@ static int piece_sink(const sph_sim *sim, const sph_sink *sink) {
   return sim->domain && sink->ops == &sph_vtk_sink_ops;
 }
 
-/* The fields rank 0's outputs read from the whole set over MPI ranks: the
- * verdict's and momenta's, the frames' positions, J and colour, the
- * probes' fields, a reference's (the VTK pieces are written per rank). */
+/* Over MPI ranks without a whole view, rank 0's probes read a set of their
+ * particles only: the nearest to each probe in the reference configuration
+ * (ties: the first created, as the probe sink picks them), by particle id,
+ * their fields taken from their owners at every frame. */
+typedef struct probe_view {
+  sph_particles *ps;    /* the probes' distinct particles by id */
+  double *rows, *got;   /* a flag then the fields, per particle */
+  unsigned long fields; /* the probes' (bit 1ul << f) */
+  int w;                /* doubles a row */
+} probe_view;
+
+static int cmp_id(const void *pa, const void *pb) {
+  int64_t a = *(const int64_t *)pa, b = *(const int64_t *)pb;
+  return (a > b) - (a < b);
+}
+
+/* the rows of the probes' particles this rank owns: fields (the position
+ * only with X) or the reference positions, to rank 0's set (collective) */
+static sph_status probe_view_fill(probe_view *pv, sph_sim *sim, int X,
+                                  sph_error *err) {
+  const sph_particles *ps = sim->ps;
+  sph_particles *v = pv->ps;
+  size_t m = v->n, w = (size_t)pv->w;
+  memset(pv->rows, 0, m * w * sizeof *pv->rows);
+  for (size_t a = 0; a < ps->n; ++a) {
+    const int64_t *k = bsearch(&ps->id[a], v->id, m, sizeof *v->id, cmp_id);
+    if (!k)
+      continue;
+    double *r = pv->rows + w * (size_t)(k - v->id);
+    r[0] = 1.0;
+    size_t c = 1;
+    for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
+      if (X ? f != SPH_FIELD_POSITION0 : !(pv->fields & 1ul << f))
+        continue;
+      size_t nc = (size_t)sph_field_components((sph_field)f);
+      memcpy(r + c, ps->field[f] + nc * a, nc * sizeof *r);
+      c += nc;
+    }
+  }
+  SPH_TRY(sph_domain_pick(sim->domain, pv->rows, m, pv->w, pv->got, err));
+  for (size_t k = 0; k < m && sph_domain_rank(sim->domain) == 0; ++k) {
+    size_t c = 1;
+    for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
+      if (X ? f != SPH_FIELD_POSITION0 : !(pv->fields & 1ul << f))
+        continue;
+      size_t nc = (size_t)sph_field_components((sph_field)f);
+      memcpy(v->field[f] + nc * k, pv->got + w * k + c, nc * sizeof *pv->got);
+      c += nc;
+    }
+  }
+  return SPH_OK;
+}
+
+static void probe_view_destroy(probe_view *pv) {
+  sph_particles_destroy(pv->ps);
+  free(pv->rows);
+  free(pv->got);
+}
+
+/* the probes' particles: the nearest owned one of each rank, then the
+ * nearest of those, ties to the smallest id (collective) */
+static sph_status probe_view_create(probe_view *pv, sph_sim *sim,
+                                    sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_particles *ps = sim->ps;
+  size_t np = s->output.nprobes, m = 0;
+  int64_t *ids = malloc((np + 1) * sizeof *ids);
+  sph_status st = ids ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "probes");
+  SPH_TRY(sph_domain_agree(sim->domain, st, err));
+  for (size_t k = 0; k < np; ++k) {
+    double best = INFINITY, id = INFINITY;
+    for (size_t a = 0; a < ps->n; ++a) {
+      const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+      double d = 0.0;
+      for (int c = 0; c < 3; ++c)
+        d += pow(X[c] - s->output.probes[k].at[c], 2);
+      if (d < best || (d == best && (double)ps->id[a] < id)) {
+        best = d;
+        id = (double)ps->id[a];
+      }
+    }
+    double dmin = sph_domain_min(sim->domain, best);
+    ids[k] = (int64_t)sph_domain_min(sim->domain, best == dmin ? id : INFINITY);
+  }
+  qsort(ids, np, sizeof *ids, cmp_id);
+  for (size_t k = 0; k < np; ++k)
+    if (m == 0 || ids[k] != ids[m - 1])
+      ids[m++] = ids[k];
+  st = sph_particles_create(&pv->ps, m ? m : 1, ps->dim, err);
+  int w = 4; /* the flag, then the reference position or the fields */
+  for (size_t k = 0; st == SPH_OK && k < np; ++k)
+    for (int i = 0; st == SPH_OK && i < s->output.probes[k].nfields; ++i) {
+      int f = s->output.probes[k].fields[i];
+      if (ps->field[f] && f != SPH_FIELD_POSITION0 &&
+          !(pv->fields & 1ul << f)) {
+        st = sph_particles_require(pv->ps, (sph_field)f, err);
+        pv->fields |= 1ul << f;
+        w += sph_field_components((sph_field)f);
+      }
+    }
+  if (st == SPH_OK) {
+    pv->w = w;
+    pv->ps->n = m;
+    memcpy(pv->ps->id, ids, m * sizeof *ids);
+    pv->rows = malloc((m * (size_t)w + 1) * sizeof *pv->rows);
+    pv->got = calloc(m * (size_t)w + 1, sizeof *pv->got);
+    if (!pv->rows || !pv->got)
+      st = sph_error_set(err, SPH_ERR_NOMEM, "probes");
+  }
+  free(ids);
+  SPH_TRY(sph_domain_agree(sim->domain, st, err));
+  return probe_view_fill(pv, sim, 1, err);
+}
+
+/* The fields rank 0's whole view holds: the frames' positions, J and
+ * colour, the probes' fields, a reference's (the VTK pieces are written
+ * per rank). */
 static unsigned long whole_fields(const sph_sim *sim) {
   const sph_scene *s = sim->scene;
-  unsigned long f = SPH_VERDICT_FIELDS | 1ul << SPH_FIELD_POSITION;
+  unsigned long f = 0;
   if (sim->reference)
     f |= SPH_REFERENCE_FIELDS;
   if (s->output.png.enabled)
-    f |= 1ul << SPH_FIELD_JACOBIAN | 1ul << s->output.png.color_field;
+    f |= 1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_JACOBIAN |
+         1ul << s->output.png.color_field;
   for (size_t k = 0; k < s->output.nprobes; ++k)
     for (int i = 0; i < s->output.probes[k].nfields; ++i)
       f |= 1ul << s->output.probes[k].fields[i];
@@ -219,28 +335,37 @@ static unsigned long whole_fields(const sph_sim *sim) {
 }
 
 /* derive, then every sink and the verdict see the same frame; over MPI
- * ranks the energies are summed over them and the fields gathered to rank
- * 0, where `view` is the run seen whole (rank 0's sinks and verdict) */
-static sph_status output_frame(sph_sim *sim, sph_sim *view, sph_sink *sinks,
-                               int nsinks, sph_verdict *v, int index,
-                               sph_error *err) {
+ * ranks the energies and momenta are summed over them, every rank judges
+ * its particles for the verdict and, when rank 0 needs a whole view, the
+ * fields are gathered to rank 0, where `view` is the run seen whole (rank
+ * 0's sinks) */
+static sph_status output_frame(sph_sim *sim, sph_sim *view, probe_view *pv,
+                               sph_sink *sinks, int nsinks, sph_verdict *v,
+                               int index, sph_error *err) {
   sph_status st = sim->method->derive(sim, err);
   if ((st = sph_domain_agree(sim->domain, st, err)) != SPH_OK)
     return st;
+  double momentum[6];
   sph_frame fr = {.time = sim->t,
                   .step = sim->steps,
                   .index = index,
                   .sim = sim,
-                  .ps = sim->ps};
+                  .ps = sim->ps,
+                  .momentum = momentum};
   sim->method->energy(sim, &fr.kinetic, &fr.strain);
+  sph_momentum(sim->ps, momentum, momentum + 3);
   sph_frame whole = fr;
   int root = sph_domain_rank(sim->domain) == 0;
   if (sim->domain) {
     double e[2] = {fr.kinetic, fr.strain};
     sph_domain_sum(sim->domain, e, 2);
+    sph_domain_sum(sim->domain, momentum, 6);
     fr.kinetic = whole.kinetic = e[0];
     fr.strain = whole.strain = e[1];
-    SPH_TRY(sph_domain_gather(sim->domain, sim->ps, err));
+    if (sph_sim_needs_whole_view(sim->scene))
+      SPH_TRY(sph_domain_gather(sim->domain, sim->ps, err));
+    else if (pv->ps)
+      SPH_TRY(probe_view_fill(pv, sim, 0, err));
     if (root) {
       sph_particles *all = view->ps;
       *view = *sim;
@@ -258,13 +383,13 @@ static sph_status output_frame(sph_sim *sim, sph_sim *view, sph_sink *sinks,
     st = st == SPH_OK ? sst : st;
     sinks[i].seconds += sph_wtime() - t0;
   }
-  if (st == SPH_OK && root)
-    st = sph_verdict_observe(v, &whole, err);
+  /* the verdict is collective: every rank observes once the sinks agree */
+  st = sph_domain_agree(sim->domain, st, err);
+  if (st == SPH_OK)
+    st = sph_verdict_observe(v, &fr, err);
   if (st == SPH_OK && sim->reference && root) /* rank 0: the gathered set */
     sph_reference_observe(sim->reference, &whole);
-  st = sph_domain_agree(sim->domain, st, err);
-  v->stable = sph_domain_bcast_int(sim->domain, v->stable);
-  return st;
+  return sph_domain_agree(sim->domain, st, err);
 }
 
 static const int run_allowed[] = {
@@ -362,10 +487,13 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error_clear(&err);
   sph_status st = SPH_OK;
   char dir[1024];
-  /* rank 0's view of a distributed run: every particle, gathered */
-  sph_domain_gather_select(sim->domain, whole_fields(sim));
+  /* rank 0's view of a distributed run: every particle, gathered, when
+   * an output reads one (sph_sim_create made it only then) */
+  int whole_view = sph_sim_needs_whole_view(scene);
+  sph_domain_gather_select(sim->domain, whole_view ? whole_fields(sim) : 0);
   sph_sim view = *sim;
-  if (sim->domain && root)
+  probe_view pv = {0};
+  if (sim->domain && root && whole_view)
     view.ps = sph_domain_global(sim->domain);
   const sph_sim *whole = sim->domain ? &view : sim;
   if (args.resume && args.out && strcmp(args.resume, args.out)) {
@@ -434,8 +562,14 @@ int sph_cmd_run(int argc, char **argv) {
     remove_previous(dir, scene->name);
   sph_halo halo = sph_domain_halo(sim->domain); /* collective */
   /* rank 0's whole set has the method's fields before the sinks open */
-  if (st == SPH_OK)
+  if (st == SPH_OK && whole_view)
     st = sph_domain_gather(sim->domain, sim->ps, &err);
+  /* else its probes' particles, from their owners */
+  if (st == SPH_OK && sim->domain && !whole_view && scene->output.nprobes) {
+    st = probe_view_create(&pv, sim, &err);
+    if (st == SPH_OK && root)
+      view.ps = pv.ps;
+  }
   if (!args.quiet)
     banner(whole, dir, &halo);
 
@@ -456,7 +590,7 @@ int sph_cmd_run(int argc, char **argv) {
   sph_verdict *verdict = NULL;
   int index = 0;
   if (st == SPH_OK)
-    st = sph_verdict_create(&verdict, root ? whole : sim, &err);
+    st = sph_verdict_create(&verdict, sim, &err); /* collective */
   if (st == SPH_OK && args.resume) {
     char used[1200];
     st = sph_checkpoint_resume(dir, sim, verdict, &index, used, sizeof used,
@@ -464,6 +598,7 @@ int sph_cmd_run(int argc, char **argv) {
     if (st != SPH_OK) {
       sph_app_print_error(&err);
       sph_verdict_destroy(verdict);
+      probe_view_destroy(&pv);
       sph_sim_destroy(sim);
       sph_scene_destroy(scene);
       return SPH_EXIT_USAGE; /* the checkpoint is the run's input */
@@ -493,7 +628,7 @@ int sph_cmd_run(int argc, char **argv) {
   double comm0 = sph_domain_seconds(sim->domain);
   int completed = 0;
   if (st == SPH_OK && index == 0)
-    st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
+    st = output_frame(sim, &view, &pv, sinks, nsinks, verdict, index++, &err);
   double t_end = scene->t_end, ckpt = scene->output.checkpoint_every;
   double eps = 1e-12 * t_end;
   double next_ckpt =
@@ -507,7 +642,7 @@ int sph_cmd_run(int argc, char **argv) {
     sph_progress_step(&prog, sim->t, sim->steps);
     if (sim->t >= next - eps) {
       sim->t = next; /* land exactly on the output time */
-      st = output_frame(sim, &view, sinks, nsinks, verdict, index++, &err);
+      st = output_frame(sim, &view, &pv, sinks, nsinks, verdict, index++, &err);
       sph_progress_output(&prog, sim->t, sim->steps);
     }
     if (st == SPH_OK && sim->t >= next_ckpt - eps && sim->t < t_end - eps) {
@@ -606,7 +741,10 @@ int sph_cmd_run(int argc, char **argv) {
   } else {
     printf("verdict: stable (%lu steps, %.2f s wall, %.3g particle-steps/s)\n",
            sim->steps, wall,
-           wall > 0 ? (double)sim->steps * (double)whole->ps->n / wall : 0.0);
+           wall > 0
+               ? (double)sim->steps *
+                     (double)sph_domain_particles(sim->domain, sim->ps) / wall
+               : 0.0);
     rc = SPH_EXIT_OK;
   }
   if (!io_failed && !args.quiet)
@@ -634,6 +772,7 @@ int sph_cmd_run(int argc, char **argv) {
   }
   rc = sph_domain_bcast_int(sim->domain, rc); /* rank 0's verdict */
   sph_verdict_destroy(verdict);
+  probe_view_destroy(&pv);
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
   if (lock_fd >= 0)

@@ -67,7 +67,12 @@ static sph_status energy_write(sph_sink *sink, const sph_frame *fr,
                                sph_error *err) {
   sph_atomic_file *af = sink->data;
   double lin[3], ang[3];
-  sph_momentum(fr->ps, lin, ang);
+  if (fr->momentum) {
+    memcpy(lin, fr->momentum, sizeof lin);
+    memcpy(ang, fr->momentum + 3, sizeof ang);
+  } else {
+    sph_momentum(fr->ps, lin, ang);
+  }
   fprintf(af->f,
           "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
           fr->time, fr->kinetic, fr->strain, fr->kinetic + fr->strain, lin[0],

@@ -95,8 +95,8 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     thread_seconds += sinks[i].thread_seconds;
   fputs("},\n  \"render_thread_seconds\": ", f);
   json_number(f, thread_seconds);
-  fprintf(f, ",\n  \"particles\": %zu,\n  \"steps\": %lu,\n", sim->ps->n,
-          sim->steps);
+  fprintf(f, ",\n  \"particles\": %zu,\n  \"steps\": %lu,\n",
+          sph_domain_particles(sim->domain, sim->ps), sim->steps);
   if (sim->domain) /* a run over MPI ranks; the timers are rank 0's */
     fprintf(f, "  \"ranks\": %d,\n", sph_domain_size(sim->domain));
   sph_domain_moves mv = sph_domain_moves_of(sim->domain);

@@ -90,6 +90,19 @@ void sph_domain_set_ghost_base(sph_domain *d, size_t base) {
 sph_particles *sph_domain_global(const sph_domain *d) {
   return d ? d->all : NULL;
 }
+size_t sph_domain_particles(const sph_domain *d, const sph_particles *ps) {
+  return d ? d->total : ps->n;
+}
+void sph_domain_drop_global(sph_domain *d) {
+  if (!d)
+    return;
+  sph_particles_destroy(d->all);
+  free(d->gbuf);
+  free(d->all_gidx);
+  d->all = NULL;
+  d->gbuf = NULL;
+  d->all_gidx = NULL;
+}
 
 sph_halo sph_domain_halo(sph_domain *d) {
   sph_halo h = {0.0, 0.0, 0.0, 0.0};
@@ -129,6 +142,7 @@ void sph_domain_destroy(sph_domain *d) {
   free(d->counts);
   free(d->offs);
   free(d->sums);
+  free(d->pbuf);
   sph_domain_dyn_destroy(d->dyn);
   free(d);
 }
@@ -583,6 +597,7 @@ static sph_status exchange_plan(sph_domain *d, const int *gowner,
 static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
   int R = d->size;
   int fail = 0;
+  d->total = N;
   if (d->rank == 0) {
     d->all_count = malloc((size_t)R * sizeof(int));
     d->all_off = malloc(((size_t)R + 1) * sizeof(int));
@@ -1358,6 +1373,172 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
   return sph_domain_agree(d, st, err);
 }
 
+sph_status sph_domain_box_points(sph_domain *d, const double *pts, size_t n,
+                                 int ncomp, double radius, double **out,
+                                 size_t *cap, size_t *m, sph_error *err) {
+  *m = 0;
+  if (!d)
+    return SPH_OK;
+  double t0 = MPI_Wtime();
+  int R = d->size, dim = d->dim;
+  size_t nc = (size_t)ncomp;
+  /* this rank's box of points widened by the radius */
+  double box[6] = {INFINITY,  INFINITY,  INFINITY,
+                   -INFINITY, -INFINITY, -INFINITY};
+  for (size_t a = 0; a < n; ++a)
+    for (int c = 0; c < dim; ++c) {
+      box[c] = fmin(box[c], pts[nc * a + (size_t)c] - radius);
+      box[3 + c] = fmax(box[3 + c], pts[nc * a + (size_t)c] + radius);
+    }
+  double *boxes = malloc(6 * (size_t)R * sizeof *boxes);
+  int *cnt = calloc(4 * (size_t)R + 2, sizeof *cnt);
+  int fail = !boxes || !cnt;
+  if (!fail)
+    MPI_Allgather(box, 6, MPI_DOUBLE, boxes, 6, MPI_DOUBLE, MPI_COMM_WORLD);
+  int *sc = cnt, *so = cnt + R, *rc = cnt + 2 * R, *ro = cnt + 3 * R + 1;
+  /* the points inside each other rank's box, counted then packed */
+  for (int pass = 0; !fail && pass < 2; ++pass) {
+    for (int q = 0; q < R; ++q)
+      sc[q] = 0;
+    for (int q = 0; q < R; ++q) {
+      const double *b = boxes + 6 * q;
+      for (size_t a = 0; q != d->rank && a < n; ++a) {
+        const double *x = pts + nc * a;
+        int in = 1;
+        for (int c = 0; c < dim && in; ++c)
+          in = x[c] >= b[c] && x[c] <= b[3 + c];
+        if (in && pass == 1)
+          memcpy(d->pbuf + nc * (size_t)(so[q] + sc[q]), x,
+                 nc * sizeof(double));
+        sc[q] += in;
+      }
+    }
+    if (pass == 0) {
+      so[0] = 0;
+      for (int q = 0; q < R; ++q)
+        so[q + 1] = so[q] + sc[q];
+      size_t need = nc * (size_t)so[R] + 1;
+      if (need > d->pbuf_cap) {
+        free(d->pbuf);
+        d->pbuf = malloc(need * sizeof *d->pbuf);
+        d->pbuf_cap = d->pbuf ? need : 0;
+        fail = !d->pbuf;
+      }
+    }
+  }
+  long f = fail, anyfail = 0;
+  MPI_Allreduce(&f, &anyfail, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+  if (!anyfail) {
+    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, MPI_COMM_WORLD);
+    ro[0] = 0;
+    for (int q = 0; q < R; ++q)
+      ro[q + 1] = ro[q] + rc[q];
+    size_t need = nc * (size_t)ro[R] + 1;
+    if (need > *cap) {
+      free(*out);
+      *out = malloc(need * sizeof **out);
+      *cap = *out ? need : 0;
+    }
+    f = !*out;
+    MPI_Allreduce(&f, &anyfail, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+  }
+  if (!anyfail) {
+    for (int q = 0; q <= R; ++q) { /* in doubles */
+      sc[q] *= q < R ? ncomp : 1;
+      so[q] *= ncomp;
+      rc[q] *= q < R ? ncomp : 1;
+      ro[q] *= ncomp;
+    }
+    MPI_Alltoallv(d->pbuf, sc, so, MPI_DOUBLE, *out, rc, ro, MPI_DOUBLE,
+                  MPI_COMM_WORLD);
+    *m = (size_t)ro[R] / nc;
+  }
+  free(boxes);
+  free(cnt);
+  d->seconds += MPI_Wtime() - t0;
+  return anyfail ? sph_error_set(err, SPH_ERR_NOMEM, "points near a rank")
+                 : SPH_OK;
+}
+
+static int cmp_i64(const void *pa, const void *pb) {
+  int64_t a = *(const int64_t *)pa, b = *(const int64_t *)pb;
+  return (a > b) - (a < b);
+}
+
+sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
+                            const int64_t *key, const double *val, size_t n,
+                            int ncomp, double *out, sph_error *err) {
+  if (!d)
+    return SPH_OK;
+  double t0 = MPI_Wtime();
+  int R = d->size, mine = (int)nwant;
+  size_t nc = (size_t)ncomp;
+  int *cnt = malloc(2 * ((size_t)R + 1) * sizeof *cnt);
+  if (!cnt)
+    return sph_error_set(err, SPH_ERR_NOMEM, "fetch");
+  int *off = cnt + R + 1;
+  MPI_Allgather(&mine, 1, MPI_INT, cnt, 1, MPI_INT, MPI_COMM_WORLD);
+  off[0] = 0;
+  for (int q = 0; q < R; ++q)
+    off[q + 1] = off[q] + cnt[q];
+  size_t total = (size_t)off[R];
+  if (total == 0) {
+    free(cnt);
+    d->seconds += MPI_Wtime() - t0;
+    return SPH_OK;
+  }
+  int64_t *all = malloc(total * sizeof *all);
+  double *ans = calloc(total * nc, sizeof *ans);
+  long f = !all || !ans, anyfail = 0;
+  MPI_Allreduce(&f, &anyfail, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+  if (!anyfail) {
+    MPI_Allgatherv(want, mine, MPI_INT64_T, all, cnt, off, MPI_INT64_T,
+                   MPI_COMM_WORLD);
+    /* the owner answers, the others add zeros: the sum is exact */
+    for (size_t i = 0; i < total; ++i) {
+      const int64_t *k =
+          n ? bsearch(all + i, key, n, sizeof *key, cmp_i64) : NULL;
+      if (k)
+        memcpy(ans + nc * i, val + nc * (size_t)(k - key), nc * sizeof *ans);
+    }
+    MPI_Allreduce(MPI_IN_PLACE, ans, (int)(total * nc), MPI_DOUBLE, MPI_SUM,
+                  MPI_COMM_WORLD);
+    memcpy(out, ans + nc * (size_t)off[d->rank], nc * nwant * sizeof *out);
+  }
+  free(cnt);
+  free(all);
+  free(ans);
+  d->seconds += MPI_Wtime() - t0;
+  return anyfail ? sph_error_set(err, SPH_ERR_NOMEM, "fetch") : SPH_OK;
+}
+
+sph_status sph_domain_pick(sph_domain *d, const double *rows, size_t m, int w,
+                           double *out, sph_error *err) {
+  if (!d)
+    return SPH_OK;
+  double t0 = MPI_Wtime();
+  size_t block = m * (size_t)w;
+  double *all =
+      d->rank == 0 ? malloc(((size_t)d->size * block + 1) * sizeof *all) : NULL;
+  sph_status st = d->rank == 0 && !all
+                      ? sph_error_set(err, SPH_ERR_NOMEM, "probe values")
+                      : SPH_OK;
+  SPH_TRY(sph_domain_agree(d, st, err));
+  MPI_Gather(rows, (int)block, MPI_DOUBLE, all, (int)block, MPI_DOUBLE, 0,
+             MPI_COMM_WORLD);
+  for (size_t k = 0; d->rank == 0 && k < m; ++k)
+    for (int q = 0; q < d->size; ++q) {
+      const double *r = all + (size_t)q * block + k * (size_t)w;
+      if (r[0] != 0.0) {
+        memcpy(out + k * (size_t)w, r, (size_t)w * sizeof *out);
+        break;
+      }
+    }
+  free(all);
+  d->seconds += MPI_Wtime() - t0;
+  return SPH_OK;
+}
+
 #else /* without MPI: one rank, no domain is ever made */
 
 sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
@@ -1436,6 +1617,26 @@ sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
 }
 void sph_domain_gather_select(sph_domain *d, unsigned long fields) {
   (void)d, (void)fields;
+}
+sph_status sph_domain_box_points(sph_domain *d, const double *pts, size_t n,
+                                 int ncomp, double radius, double **out,
+                                 size_t *cap, size_t *m, sph_error *err) {
+  (void)d, (void)pts, (void)n, (void)ncomp, (void)radius, (void)out;
+  (void)cap, (void)err;
+  *m = 0;
+  return SPH_OK;
+}
+sph_status sph_domain_pick(sph_domain *d, const double *rows, size_t m, int w,
+                           double *out, sph_error *err) {
+  (void)d, (void)rows, (void)m, (void)w, (void)out, (void)err;
+  return SPH_OK;
+}
+sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
+                            const int64_t *key, const double *val, size_t n,
+                            int ncomp, double *out, sph_error *err) {
+  (void)d, (void)want, (void)nwant, (void)key, (void)val, (void)n;
+  (void)ncomp, (void)out, (void)err;
+  return SPH_OK;
 }
 
 #endif

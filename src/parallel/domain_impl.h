@@ -35,7 +35,10 @@ struct sph_domain {
   double seconds;           /* in exchanges, reductions and gathers */
   double sent, messages;    /* doubles and messages the exchanges sent */
   double *sums;             /* 16 per rank: sph_domain_sum's gather */
-  sph_domain_dyn *dyn;      /* updated-Lagrangian runs, else NULL */
+  size_t total;             /* particles of the whole run */
+  double *pbuf;             /* sph_domain_box_points' packed sends */
+  size_t pbuf_cap;
+  sph_domain_dyn *dyn; /* updated-Lagrangian runs, else NULL */
 };
 
 typedef struct rcb_key {
