@@ -42,10 +42,11 @@ void sph_domain_destroy(sph_domain *d);
  * the N particles (*ps, any subset as sph_scene_build_share makes them,
  * with their storage indices gidx; *ps becomes the owned set, NULL after
  * an error past the partition); the owned sets, storage indices,
- * ghosts and halo are sph_domain_create's. Collective. */
+ * ghosts and halo are sph_domain_create's; with dynamic, the owned sets
+ * and cut tree of sph_domain_create_dynamic. Collective. */
 sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
                                    const int64_t *gidx, size_t N,
-                                   double support, sph_error *err);
+                                   double support, int dynamic, sph_error *err);
 /* Rank 0's whole set (sph_domain_global) from the owned sets ps of every
  * rank (collective): reference positions, volumes, initial velocities, ids,
  * bodies and flags at their storage indices, in the serial order. Made once

@@ -913,9 +913,10 @@ static sph_status share_ghosts(const share_rec *own, size_t n, share_rec *cand,
 }
 
 /* the owned set from the owned records, in storage order */
-static sph_status share_owned_set(const share_rec *own, size_t n, int dim,
-                                  sph_particles **out, sph_error *err) {
-  SPH_TRY(sph_particles_create(out, n, dim, err));
+static sph_status share_owned_set(const share_rec *own, size_t n,
+                                  size_t capacity, int dim, sph_particles **out,
+                                  sph_error *err) {
+  SPH_TRY(sph_particles_create(out, capacity, dim, err));
   sph_particles *o = *out;
   SPH_TRY(sph_particles_require(o, SPH_FIELD_VELOCITY, err));
   for (size_t a = 0; a < n; ++a) {
@@ -989,7 +990,8 @@ static sph_status share_candidates(share_rec *own, size_t n, int dim,
 
 sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
                                    const int64_t *gidx, size_t N,
-                                   double support, sph_error *err) {
+                                   double support, int dynamic,
+                                   sph_error *err) {
   *out = NULL;
   sph_particles *in = *ps;
   size_t m = in->n;
@@ -998,6 +1000,9 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   int *owner = malloc((m ? m : 1) * sizeof *owner);
   int *count = calloc((size_t)R, sizeof *count);
   share_rec *send = malloc((m ? m : 1) * sizeof *send);
+  int *axis = malloc(((size_t)R + 1) * sizeof *axis);
+  double *cut = malloc(((size_t)R + 1) * sizeof *cut);
+  size_t cap = dynamic ? sph_domain_dyn_capacity(N, R) : 0;
   if (d) {
     d->rank = world_rank;
     d->size = world_size;
@@ -1005,7 +1010,7 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
     d->gathered = ~0ul;
     d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
   }
-  sph_status st = d && d->sums && owner && count && send
+  sph_status st = d && d->sums && owner && count && send && axis && cut
                       ? SPH_OK
                       : sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
   sph_domain world = {.rank = world_rank, .size = world_size};
@@ -1016,7 +1021,7 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   /* sph_domain_rcb's partition: ties by storage index */
   if (st == SPH_OK) {
     sph_domain_rcb_counted(in->field[SPH_FIELD_POSITION0], gidx, m, dim, owner,
-                           NULL, NULL, NULL);
+                           axis, cut, NULL);
     for (size_t i = 0; i < m; ++i)
       if (owner[i] < 0)
         st = sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
@@ -1059,14 +1064,17 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
     qsort(own, d->n, sizeof *own, cmp_rec_storage);
     for (size_t a = 0; a < d->n; ++a)
       own[a].owner = world_rank;
-    st = share_candidates(own, d->n, dim, support, type, &cand, &nc, err);
+    /* a dynamic domain finds its ghosts at each rebuild */
+    if (!dynamic)
+      st = share_candidates(own, d->n, dim, support, type, &cand, &nc, err);
   }
-  if (st == SPH_OK)
+  if (st == SPH_OK && !dynamic)
     st = share_ghosts(own, d->n, cand, nc, dim, support, &ghost, &ng, err);
   free(cand);
   if (st == SPH_OK) {
     d->ng = ng;
-    d->gidx = malloc((d->n + ng ? d->n + ng : 1) * sizeof *d->gidx);
+    size_t gm = d->n + ng > cap ? d->n + ng : cap;
+    d->gidx = malloc((gm ? gm : 1) * sizeof *d->gidx);
     d->gX = malloc(3 * (ng + 1) * sizeof *d->gX);
     d->gV = malloc((ng + 1) * sizeof *d->gV);
     d->gbody = malloc((ng + 1) * sizeof *d->gbody);
@@ -1097,11 +1105,16 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   free(gowner);
   sph_particles *mine = NULL;
   if (st == SPH_OK)
-    st = share_owned_set(own, d->n, dim, &mine, err);
+    st = share_owned_set(own, d->n, cap > d->n ? cap : d->n, dim, &mine, err);
   free(own);
   st = sph_domain_agree(&world, st, err);
   if (st == SPH_OK)
     st = gather_plan(d, N, err);
+  if (st == SPH_OK && dynamic)
+    st = sph_domain_dyn_create(d, N, axis, cut, err);
+  st = sph_domain_agree(&world, st, err);
+  free(axis);
+  free(cut);
   if (st != SPH_OK) {
     sph_particles_destroy(mine);
     sph_domain_destroy(d);
@@ -1563,8 +1576,9 @@ sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
 
 sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
                                    const int64_t *gidx, size_t N,
-                                   double support, sph_error *err) {
-  (void)gidx, (void)N;
+                                   double support, int dynamic,
+                                   sph_error *err) {
+  (void)gidx, (void)N, (void)dynamic;
   return sph_domain_create(out, ps, support, err);
 }
 

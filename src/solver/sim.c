@@ -170,8 +170,9 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
     return sph_domain_dyn_mirror(sim->domain, planes, np, 3.0, err);
   }
   if (gidx)
-    return sph_domain_create_share(&sim->domain, &sim->ps, gidx, N,
-                                   sim->kernel.support, err);
+    return sph_domain_create_share(
+        &sim->domain, &sim->ps, gidx, N, sim->kernel.support,
+        sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC, err);
   if (np)
     return sph_domain_create_mirrored(&sim->domain, &sim->ps,
                                       sim->kernel.support, planes, np, err);
@@ -182,12 +183,11 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
 }
 
 /* Whether each rank can build its own share of the particles without the
- * whole set (sph_scene_build_share): a fixed domain without symmetry planes
- * (their mirror ghosts and the dynamic domain's cut tree come from the
- * whole set), bodies of lattice or jitter points (a relaxation moves the
- * whole body). */
+ * whole set (sph_scene_build_share): no symmetry planes (their mirror
+ * ghosts and images come from the whole set), bodies of lattice or jitter
+ * points (a relaxation moves the whole body). */
 static int per_rank_setup(const sph_scene *s, const sph_method_ops *method) {
-  if (sph_domain_world_size() < 2 || method->distributed != 1)
+  if (sph_domain_world_size() < 2 || !method->distributed)
     return 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||

@@ -4,9 +4,9 @@
  * owned particles (fields, ids, bodies, flags bit for bit), storage
  * indices, ghosts (positions, volumes, bodies, ids, in the same order) and
  * halo plan, and rank 0's whole set (sph_domain_whole_create) the sorted
- * whole set. 3D face lattice with jitter (a turned column), 2D cells with
- * jitter, two 3D bodies (a block and a punch). Run under mpirun (ctest: 2, 3
- * and 4 ranks). */
+ * whole set; the same for the updated-Lagrangian (dynamic) domain. 3D face
+ * lattice with jitter (a turned column), 2D cells with jitter, two 3D bodies (a
+ * block and a punch). Run under mpirun (ctest: 2, 3 and 4 ranks). */
 #include "parallel/domain_impl.h"
 
 #include <check.h>
@@ -33,8 +33,9 @@ static int same_set(const sph_particles *a, const sph_particles *b) {
          SAME(a->flags, b->flags, a->n);
 }
 
-/* ranks where the two set-ups differ */
-static int differences(const char *text, double support) {
+/* ranks where the two set-ups differ (dynamic: the updated-Lagrangian
+ * domain's, owned sets and their room) */
+static int differences(const char *text, double support, int dynamic) {
   sph_scene *s = sph_test_scene_text(text);
   sph_error err;
   sph_particles *whole = NULL, *share = NULL;
@@ -63,12 +64,18 @@ static int differences(const char *text, double support) {
   memcpy(sorted->body, whole->body, whole->n * sizeof *whole->body);
   memcpy(sorted->flags, whole->flags, whole->n * sizeof *whole->flags);
   sph_domain *a = NULL, *b = NULL;
-  ck_assert_int_eq(sph_domain_create(&a, &whole, support, &err), SPH_OK);
-  ck_assert_int_eq(sph_domain_create_share(&b, &share, gidx, N, support, &err),
+  ck_assert_int_eq(dynamic
+                       ? sph_domain_create_dynamic(&a, &whole, support, &err)
+                       : sph_domain_create(&a, &whole, support, &err),
                    SPH_OK);
+  ck_assert_int_eq(
+      sph_domain_create_share(&b, &share, gidx, N, support, dynamic, &err),
+      SPH_OK);
   ck_assert_int_eq(sph_domain_whole_create(b, share, &err), SPH_OK);
   int bad = a->n != b->n || a->ng != b->ng || a->nsend != b->nsend ||
-            !same_set(whole, share);
+            !same_set(whole, share) || whole->capacity != share->capacity ||
+            sph_domain_migrates(a) != dynamic ||
+            sph_domain_migrates(b) != dynamic;
   if (!bad) {
     size_t ng = a->ng;
     bad = !SAME(a->gidx, b->gidx, a->n + ng) || !SAME(a->gX, b->gX, 3 * ng) ||
@@ -108,7 +115,8 @@ START_TEST(column_3d) {
          "  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: "
          "true}\n";
   /* the support of h = 1.3 dp, wendland: 2.6 dp */
-  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0), 0);
+  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0, 0), 0);
+  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0, 1), 0);
 }
 END_TEST
 
@@ -120,7 +128,8 @@ START_TEST(ring_2d) {
          "outer_radius: 0.35}}\n"
          "    particles: {spacing: 0.01, distribution: jitter, seed: 5}\n"
          "    initial_velocity: {uniform: [1, 0, 0]}\n";
-  ck_assert_int_eq(differences(scene, 0.026), 0);
+  ck_assert_int_eq(differences(scene, 0.026, 0), 0);
+  ck_assert_int_eq(differences(scene, 0.026, 1), 0);
 }
 END_TEST
 
@@ -136,7 +145,8 @@ START_TEST(bodies_3d) {
          "0.3, length: 0.5}}\n"
          "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
          "    initial_velocity: {uniform: [0, -1, 0]}\n";
-  ck_assert_int_eq(differences(scene, 0.26), 0);
+  ck_assert_int_eq(differences(scene, 0.26, 0), 0);
+  ck_assert_int_eq(differences(scene, 0.26, 1), 0);
 }
 END_TEST
 
