@@ -134,11 +134,9 @@ void sph_domain_destroy(sph_domain *d) {
   free(d->send_idx);
   free(d->buf);
   free(d->req);
-  sph_particles_destroy(d->all);
+  sph_domain_drop_global(d);
   free(d->all_count);
   free(d->all_off);
-  free(d->all_gidx);
-  free(d->gbuf);
   free(d->counts);
   free(d->offs);
   free(d->sums);

@@ -13,6 +13,8 @@
 #include <mpi.h>
 #include <stdlib.h>
 
+#include "mpi_check.h"
+
 /* particles of the whole set whose owners disagree and cuts of the tree
  * that differ, over all ranks (owners only with work, else the tree too) */
 static long mismatches_with(const double *X, size_t N, int dim, int work) {
@@ -158,11 +160,5 @@ int main(int argc, char **argv) {
   tcase_add_test(tc, test_plane);
   tcase_add_test(tc, test_random_points);
   suite_add_tcase(s, tc);
-  SRunner *sr = srunner_create(s);
-  srunner_set_fork_status(sr, CK_NOFORK); /* one MPI process a rank */
-  srunner_run_all(sr, sph_domain_world_rank() == 0 ? CK_NORMAL : CK_SILENT);
-  int failed = srunner_ntests_failed(sr);
-  srunner_free(sr);
-  sph_domain_finalize();
-  return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+  return sph_mpi_check_run(s);
 }

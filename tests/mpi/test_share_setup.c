@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpi_check.h"
 #include "sph/scene.h"
 #include "test_scene_util.h"
 
@@ -161,11 +162,5 @@ int main(int argc, char **argv) {
   tcase_add_test(t, ring_2d);
   tcase_add_test(t, bodies_3d);
   suite_add_tcase(s, t);
-  SRunner *sr = srunner_create(s);
-  srunner_set_fork_status(sr, CK_NOFORK); /* one MPI process a rank */
-  srunner_run_all(sr, sph_domain_world_rank() == 0 ? CK_NORMAL : CK_SILENT);
-  int failed = srunner_ntests_failed(sr);
-  srunner_free(sr);
-  sph_domain_finalize();
-  return failed == 0 ? 0 : 1;
+  return sph_mpi_check_run(s);
 }
