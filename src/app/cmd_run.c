@@ -106,10 +106,10 @@ static void remove_run_files(const char *dir, const char *scene) {
         ours = run_file(e->d_name, scene, *x, 0);
       ours = ours || (k == 0 && (piece_file(e->d_name, scene) ||
                                  checkpoint_piece(e->d_name)));
-      if (!ours)
-        continue;
-      snprintf(path, sizeof path, "%s/%s", sub[k], e->d_name);
-      remove(path);
+      /* a cut path would name another file */
+      if (ours && snprintf(path, sizeof path, "%s/%s", sub[k], e->d_name) <
+                      (int)sizeof path)
+        remove(path);
     }
     if (d)
       closedir(d);
