@@ -128,10 +128,11 @@ void sph_domain_sum_long(sph_domain *d, double *v, size_t count, double *work,
 /* Root's value on every rank. */
 int sph_domain_bcast_int(sph_domain *d, int v);
 /* Every rank receives every rank's count values in rank order: *out
- * (allocated, to be freed) holds *total of them. Set-up only. */
+ * (allocated, to be freed) holds *total of them, this rank's from *first
+ * (when not NULL). Outside the time step only (it allocates). */
 sph_status sph_domain_allgather_i64(sph_domain *d, const int64_t *v,
                                     size_t count, int64_t **out, size_t *total,
-                                    sph_error *err);
+                                    size_t *first, sph_error *err);
 /* Rank 0 receives count values of every rank in rank order (out: count
  * per rank; unused on the other ranks). */
 void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,

@@ -1482,29 +1482,17 @@ sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
   if (!d)
     return SPH_OK;
   double t0 = MPI_Wtime();
-  int R = d->size, mine = (int)nwant;
-  size_t nc = (size_t)ncomp;
-  int *cnt = malloc(2 * ((size_t)R + 1) * sizeof *cnt);
-  if (!cnt)
-    return sph_error_set(err, SPH_ERR_NOMEM, "fetch");
-  int *off = cnt + R + 1;
-  MPI_Allgather(&mine, 1, MPI_INT, cnt, 1, MPI_INT, MPI_COMM_WORLD);
-  off[0] = 0;
-  for (int q = 0; q < R; ++q)
-    off[q + 1] = off[q] + cnt[q];
-  size_t total = (size_t)off[R];
-  if (total == 0) {
-    free(cnt);
-    d->seconds += MPI_Wtime() - t0;
-    return SPH_OK;
+  size_t nc = (size_t)ncomp, total = 0, at = 0;
+  int64_t *all = NULL;
+  double *ans = NULL;
+  sph_status st =
+      sph_domain_allgather_i64(d, want, nwant, &all, &total, &at, err);
+  if (st == SPH_OK && total) {
+    ans = calloc(total * nc, sizeof *ans);
+    st = sph_domain_agree(
+        d, ans ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "fetch"), err);
   }
-  int64_t *all = malloc(total * sizeof *all);
-  double *ans = calloc(total * nc, sizeof *ans);
-  long f = !all || !ans, anyfail = 0;
-  MPI_Allreduce(&f, &anyfail, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
-  if (!anyfail) {
-    MPI_Allgatherv(want, mine, MPI_INT64_T, all, cnt, off, MPI_INT64_T,
-                   MPI_COMM_WORLD);
+  if (st == SPH_OK && total) {
     /* the owner answers, the others add zeros: the sum is exact */
     for (size_t i = 0; i < total; ++i) {
       const int64_t *k =
@@ -1514,13 +1502,12 @@ sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
     }
     MPI_Allreduce(MPI_IN_PLACE, ans, (int)(total * nc), MPI_DOUBLE, MPI_SUM,
                   MPI_COMM_WORLD);
-    memcpy(out, ans + nc * (size_t)off[d->rank], nc * nwant * sizeof *out);
+    memcpy(out, ans + nc * at, nc * nwant * sizeof *out);
   }
-  free(cnt);
   free(all);
   free(ans);
   d->seconds += MPI_Wtime() - t0;
-  return anyfail ? sph_error_set(err, SPH_ERR_NOMEM, "fetch") : SPH_OK;
+  return st;
 }
 
 sph_status sph_domain_pick(sph_domain *d, const double *rows, size_t m, int w,
@@ -1679,7 +1666,7 @@ void sph_domain_sort_lists_by(sph_neighbors *nl, size_t n, const int64_t *key) {
 /* (with or without MPI: one rank copies its values) */
 sph_status sph_domain_allgather_i64(sph_domain *d, const int64_t *v,
                                     size_t count, int64_t **out, size_t *total,
-                                    sph_error *err) {
+                                    size_t *first, sph_error *err) {
   *out = NULL;
   *total = 0;
   int R = d ? d->size : 1, mine = (int)count;
@@ -1713,6 +1700,8 @@ sph_status sph_domain_allgather_i64(sph_domain *d, const int64_t *v,
 #endif
   *out = all;
   *total = (size_t)off[R];
+  if (first)
+    *first = (size_t)off[d ? d->rank : 0];
   all = NULL;
 done:
   free(all);

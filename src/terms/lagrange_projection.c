@@ -507,7 +507,7 @@ static sph_status lp_points_distributed(lagrange_projection *lp,
   }
   st = sph_domain_agree(d, st, err);
   if (st == SPH_OK)
-    st = sph_domain_allgather_i64(d, own, 2 * mine, &sel, &nb, err);
+    st = sph_domain_allgather_i64(d, own, 2 * mine, &sel, &nb, NULL, err);
   if (st != SPH_OK)
     goto done;
   nb /= 2;
