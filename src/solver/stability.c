@@ -142,20 +142,15 @@ static sph_status local_points(sph_verdict *v, const sph_particles *ps,
   SPH_TRY(sph_domain_box_points(v->dom, v->pts, n, 6, radius, &v->near,
                                 &v->near_cap, &v->nnear, err));
   size_t tot = n + v->nnear;
-  if (tot > v->local_cap) {
-    size_t c = tot + tot / 4 + 16;
-    free(v->lx);
-    free(v->ls);
-    free(v->lbody);
-    free(v->lkey);
-    v->lx = malloc(3 * c * sizeof *v->lx);
-    v->ls = malloc(c * sizeof *v->ls);
-    v->lbody = malloc(c * sizeof *v->lbody);
-    v->lkey = malloc(c * sizeof *v->lkey);
-    v->local_cap = v->lx && v->ls && v->lbody && v->lkey ? c : 0;
-    if (!v->local_cap)
-      st = sph_error_set(err, SPH_ERR_NOMEM, "verdict");
-  }
+  /* four arrays of one capacity: each grows alike from it */
+  size_t c[4] = {v->local_cap, v->local_cap, v->local_cap, v->local_cap};
+  if (!grow((void **)&v->lx, &c[0], tot, 3 * sizeof *v->lx) ||
+      !grow((void **)&v->ls, &c[1], tot, sizeof *v->ls) ||
+      !grow((void **)&v->lbody, &c[2], tot, sizeof *v->lbody) ||
+      !grow((void **)&v->lkey, &c[3], tot, sizeof *v->lkey))
+    st = sph_error_set(err, SPH_ERR_NOMEM, "verdict");
+  else
+    v->local_cap = c[0];
   for (size_t a = 0; st == SPH_OK && a < tot; ++a) {
     const double *p = a < n ? v->pts + 6 * a : v->near + 6 * (a - n);
     memcpy(v->lx + 3 * a, p, 3 * sizeof *v->lx);
