@@ -179,6 +179,15 @@ sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
  * rows of no rank are left; collective; nothing for NULL). */
 sph_status sph_domain_pick(sph_domain *d, const double *rows, size_t m, int w,
                            double *out, sph_error *err);
+/* Rank 0 receives into out the w doubles of each particle whose storage
+ * index k is in [lo, lo + m), at out + w * (k - lo), from its owner: each
+ * rank passes the n rows of its particles in that range and their storage
+ * indices key (collective; out is filled directly for NULL). Outside the
+ * time step only (it allocates). */
+sph_status sph_domain_gather_range(sph_domain *d, const int64_t *key,
+                                   const double *rows, size_t n, int w,
+                                   int64_t lo, size_t m, double *out,
+                                   sph_error *err);
 /* Rank 0's whole particle set (NULL elsewhere and for NULL). */
 sph_particles *sph_domain_global(const sph_domain *d);
 /* Gathers the fields of `local` among those selected (every field until

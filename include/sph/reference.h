@@ -59,7 +59,8 @@ void sph_reference_destroy(sph_reference *r);
 sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
                                     sph_error *err);
 
-/* Takes an output frame (after method->derive) into the measurement. */
+/* Takes an output frame (after method->derive) into the measurement; over
+ * MPI ranks collective (the owner of the observed particle gives it). */
 void sph_reference_observe(sph_reference *r, const sph_frame *frame);
 
 /* The measurement's state for checkpoints: fills arr and returns 1, or 0
@@ -67,14 +68,11 @@ void sph_reference_observe(sph_reference *r, const sph_frame *frame);
 int sph_reference_state(sph_reference *r, sph_state_array *arr);
 
 /* Errors of the derived fields (velocity, first Piola-Kirchhoff stress,
- * displacement x - X) at the sim's time; over MPI ranks rank 0 gathers the
- * fields they read, SPH_REFERENCE_FIELDS (bit 1ul << f), besides the
- * reference positions and volumes. */
-#define SPH_REFERENCE_FIELDS                                                   \
-  (1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_VELOCITY |                     \
-   1ul << SPH_FIELD_DISPLACEMENT | 1ul << SPH_FIELD_PK1 |                      \
-   1ul << SPH_FIELD_DEFGRAD)
-void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
-                          sph_reference_error *e);
+ * displacement x - X) at the sim's time, or the measured period. Over MPI
+ * ranks collective, the result on rank 0: it adds every particle's terms
+ * in the serial order (a range of storage indices at a time), so the
+ * errors are the serial run's. */
+sph_status sph_reference_errors(const sph_reference *r, const sph_sim *sim,
+                                sph_reference_error *e, sph_error *err);
 
 #endif

@@ -69,6 +69,7 @@
 #define SPH_STABILITY_H
 
 #include "sph/neighbors.h"
+#include "sph/reference.h"
 #include "sph/sink.h"
 
 /* The indicators, in the order a frame checks them: enum name, the key in
@@ -208,12 +209,14 @@ typedef struct sph_provenance {
   const char *command; /* the command line, words joined by spaces */
 } sph_provenance;
 
-/* summary.json (keys documented in the README): `sinks` holds the wall
+/* summary.json (keys documented in the README): ref holds the errors
+ * against the scene's reference (NULL: none); `sinks` holds the wall
  * seconds of each of the nsinks sinks; mp4_seconds >= 0 adds the time the
  * mp4 took to assemble; stopped_by names the signal that stopped the run
  * (NULL: none). */
 sph_status sph_summary_write(const char *path, const sph_sim *sim,
                              const sph_provenance *prov, const sph_verdict *v,
+                             const sph_reference_error *ref,
                              double wall_seconds, const sph_sink *sinks,
                              int nsinks, double mp4_seconds, int completed,
                              const char *stopped_by, sph_error *err);

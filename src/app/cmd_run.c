@@ -318,13 +318,10 @@ static sph_status probe_view_create(probe_view *pv, sph_sim *sim,
 }
 
 /* The fields rank 0's whole view holds: the frames' positions, J and
- * colour, the probes' fields, a reference's (the VTK pieces are written
- * per rank). */
+ * colour, the probes' fields (the VTK pieces are written per rank). */
 static unsigned long whole_fields(const sph_sim *sim) {
   const sph_scene *s = sim->scene;
   unsigned long f = 0;
-  if (sim->reference)
-    f |= SPH_REFERENCE_FIELDS;
   if (s->output.png.enabled)
     f |= 1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_JACOBIAN |
          1ul << s->output.png.color_field;
@@ -387,8 +384,8 @@ static sph_status output_frame(sph_sim *sim, sph_sim *view, probe_view *pv,
   st = sph_domain_agree(sim->domain, st, err);
   if (st == SPH_OK)
     st = sph_verdict_observe(v, &fr, err);
-  if (st == SPH_OK && sim->reference && root) /* rank 0: the gathered set */
-    sph_reference_observe(sim->reference, &whole);
+  if (st == SPH_OK && sim->reference) /* collective: from its owner */
+    sph_reference_observe(sim->reference, &fr);
   return sph_domain_agree(sim->domain, st, err);
 }
 
@@ -699,6 +696,14 @@ int sph_cmd_run(int argc, char **argv) {
   double comm = sph_domain_seconds(sim->domain) - comm0;
   double work = sph_domain_max(sim->domain, wall - comm);
   comm = sph_domain_max(sim->domain, comm);
+  /* the errors against the reference, in the serial order (collective) */
+  sph_reference_error ref_err;
+  if (verdict && sim->reference &&
+      sph_reference_errors(sim->reference, sim, &ref_err, &cerr) != SPH_OK &&
+      !io_failed) {
+    io_failed = 1;
+    err = cerr;
+  }
   /* the animation of the frames, once the run has ended */
   sph_mp4_info mp4 = {0};
   sph_error merr;
@@ -716,7 +721,8 @@ int sph_cmd_run(int argc, char **argv) {
     sph_particles *all = view.ps;
     view = *sim; /* the counts and timers of the end of the run */
     view.ps = all;
-    if (sph_summary_write(spath, whole, &prov, verdict, wall, sinks, nsinks,
+    if (sph_summary_write(spath, whole, &prov, verdict,
+                          sim->reference ? &ref_err : NULL, wall, sinks, nsinks,
                           mp4_tried && mst == SPH_OK ? mp4.seconds : -1.0,
                           completed, stopped ? signal_name(stopped) : NULL,
                           &cerr) != SPH_OK) {

@@ -30,6 +30,7 @@ static void json_number(FILE *f, double x) {
 
 sph_status sph_summary_write(const char *path, const sph_sim *sim,
                              const sph_provenance *prov, const sph_verdict *v,
+                             const sph_reference_error *ref,
                              double wall_seconds, const sph_sink *sinks,
                              int nsinks, double mp4_seconds, int completed,
                              const char *stopped_by, sph_error *err) {
@@ -155,9 +156,8 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     json_number(f, v->tripped_at[i]);
   }
   fputc('}', f);
-  if (sim->reference) {
-    sph_reference_error e;
-    sph_reference_errors(sim->reference, sim, &e);
+  if (ref) {
+    sph_reference_error e = *ref;
     /* the quantities this reference gives */
     const struct {
       const char *key;

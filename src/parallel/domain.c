@@ -201,6 +201,14 @@ void sph_domain_rcb(const double *X, int dim, rcb_key *k, size_t n, int rank0,
                  axis, cutv);
 }
 
+/* rows of w doubles placed at their storage index less lo */
+static void place_rows(double *out, const int64_t *key, const double *rows,
+                       size_t n, int w, int64_t lo) {
+  for (size_t i = 0; i < n; ++i)
+    memcpy(out + (size_t)w * (size_t)(key[i] - lo), rows + (size_t)w * i,
+           (size_t)w * sizeof *out);
+}
+
 #ifdef SPH_HAVE_MPI
 
 /* ---- the same partition by counting bisection ------------------------- */
@@ -1537,6 +1545,58 @@ sph_status sph_domain_pick(sph_domain *d, const double *rows, size_t m, int w,
   return SPH_OK;
 }
 
+sph_status sph_domain_gather_range(sph_domain *d, const int64_t *key,
+                                   const double *rows, size_t n, int w,
+                                   int64_t lo, size_t m, double *out,
+                                   sph_error *err) {
+  size_t nw = (size_t)w;
+  if (!d) {
+    place_rows(out, key, rows, n, w, lo);
+    return SPH_OK;
+  }
+  double t0 = MPI_Wtime();
+  int R = d->size, mine = (int)n, *cnt = NULL, *off = NULL, *vcnt = NULL,
+      *voff = NULL;
+  int64_t *keys = NULL;
+  double *vals = NULL;
+  int fail = 0;
+  if (d->rank == 0) {
+    cnt = malloc((size_t)R * sizeof *cnt);
+    off = malloc((size_t)R * sizeof *off);
+    vcnt = malloc((size_t)R * sizeof *vcnt);
+    voff = malloc((size_t)R * sizeof *voff);
+    keys = malloc((m ? m : 1) * sizeof *keys);
+    vals = malloc((m ? m : 1) * nw * sizeof *vals);
+    fail = !cnt || !off || !vcnt || !voff || !keys || !vals;
+  }
+  sph_status st = sph_domain_agree(
+      d, fail ? sph_error_set(err, SPH_ERR_NOMEM, "gather of a range") : SPH_OK,
+      err);
+  if (st == SPH_OK) {
+    MPI_Gather(&mine, 1, MPI_INT, cnt, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    for (int q = 0, at = 0; d->rank == 0 && q < R; at += cnt[q++]) {
+      off[q] = at;
+      vcnt[q] = w * cnt[q];
+      voff[q] = w * at;
+    }
+    MPI_Gatherv(key, mine, MPI_INT64_T, keys, cnt, off, MPI_INT64_T, 0,
+                MPI_COMM_WORLD);
+    MPI_Gatherv(rows, w * mine, MPI_DOUBLE, vals, vcnt, voff, MPI_DOUBLE, 0,
+                MPI_COMM_WORLD);
+    if (d->rank == 0)
+      place_rows(out, keys, vals, (size_t)off[R - 1] + (size_t)cnt[R - 1], w,
+                 lo);
+  }
+  free(cnt);
+  free(off);
+  free(vcnt);
+  free(voff);
+  free(keys);
+  free(vals);
+  d->seconds += MPI_Wtime() - t0;
+  return st;
+}
+
 #else /* without MPI: one rank, no domain is ever made */
 
 sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
@@ -1638,6 +1698,14 @@ sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
   return SPH_OK;
 }
 
+sph_status sph_domain_gather_range(sph_domain *d, const int64_t *key,
+                                   const double *rows, size_t n, int w,
+                                   int64_t lo, size_t m, double *out,
+                                   sph_error *err) {
+  (void)d, (void)m, (void)err;
+  place_rows(out, key, rows, n, w, lo);
+  return SPH_OK;
+}
 #endif
 
 /* ascending storage index within each list: insertion sort of the usual

@@ -32,7 +32,8 @@ struct sph_reference {
   double at[3];
   int component;
   double value, tolerance;
-  size_t particle;
+  int64_t key; /* the observed particle's storage index */
+  size_t slot; /* where this rank last found it */
   double obs[OBS_N];
   /* swinging cube */
   double U0, A[3];
@@ -230,22 +231,25 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
   sph_particles *ps = sim->ps;
   sph_reference *rw = (sph_reference *)r; /* amplitude found on the set */
   if (r->kind == REF_PERIOD) {
-    /* over MPI ranks rank 0 observes the gathered set (the serial order) */
-    const sph_particles *all =
-        sim->domain ? sph_domain_global(sim->domain) : ps;
     memset(rw->obs, 0, sizeof rw->obs);
-    /* the particle nearest to `at` in the reference configuration */
-    double best = INFINITY;
-    for (size_t a = 0; all && a < all->n; ++a) {
-      const double *X = all->field[SPH_FIELD_POSITION0] + 3 * a;
-      double d = 0.0;
+    /* the particle nearest to `at` in the reference configuration, ties
+     * to the first in storage order (over MPI ranks: of every rank's) */
+    const int64_t *g = sph_domain_storage_index(sim->domain);
+    double best = INFINITY, key = INFINITY;
+    for (size_t a = 0; a < ps->n; ++a) {
+      const double *X = ps->field[SPH_FIELD_POSITION0] + 3 * a;
+      double d = 0.0, k = g ? (double)g[a] : (double)a;
       for (int c = 0; c < 3; ++c)
         d += (X[c] - r->at[c]) * (X[c] - r->at[c]);
-      if (d < best) {
+      if (d < best || (d == best && k < key)) {
         best = d;
-        rw->particle = a;
+        key = k;
       }
     }
+    double dmin = sph_domain_min(sim->domain, best);
+    rw->key =
+        (int64_t)sph_domain_min(sim->domain, best == dmin ? key : INFINITY);
+    rw->slot = SIZE_MAX;
     return SPH_OK;
   }
   /* over MPI ranks each rank sets its owned particles' state */
@@ -295,9 +299,20 @@ void sph_reference_observe(sph_reference *r, const sph_frame *fr) {
   if (r->kind != REF_PERIOD)
     return;
   const sph_particles *ps = fr->ps;
+  sph_domain *dom = fr->sim->domain;
+  const int64_t *g = sph_domain_storage_index(dom);
+  /* the observed particle, where this rank last had it or found again */
+  size_t a = r->slot;
+  if (!(a < ps->n && (g ? g[a] : (int64_t)a) == r->key))
+    for (a = 0; a < ps->n && (g ? g[a] : (int64_t)a) != r->key; ++a)
+      ;
+  r->slot = a;
   int c = r->component;
-  double u = ps->field[SPH_FIELD_POSITION][3 * r->particle + c] -
-             ps->field[SPH_FIELD_POSITION0][3 * r->particle + c];
+  /* its owner's displacement, zeros from the others: the sum is exact */
+  double u = a < ps->n ? ps->field[SPH_FIELD_POSITION][3 * a + c] -
+                             ps->field[SPH_FIELD_POSITION0][3 * a + c]
+                       : 0.0;
+  sph_domain_sum(dom, &u, 1);
   double *o = r->obs, sign = u > 0.0 ? 1.0 : u < 0.0 ? -1.0 : 0.0;
   /* a zero crossing between the previous sample and this one */
   if (sign != 0.0 && o[OBS_SIGN] != 0.0 && sign != o[OBS_SIGN]) {
@@ -320,8 +335,102 @@ int sph_reference_state(sph_reference *r, sph_state_array *arr) {
   return 1;
 }
 
-void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
-                          sph_reference_error *e) {
+/* a particle's row for the errors: V, X, v, u, P, F */
+enum {
+  ROW_V = 0,
+  ROW_X = 1,
+  ROW_VEL = 4,
+  ROW_U = 7,
+  ROW_P = 10,
+  ROW_F = 19,
+  ROW_W = 28
+};
+
+static void error_row(const sph_particles *ps, size_t a, double *row) {
+  row[ROW_V] = ps->field[SPH_FIELD_VOLUME0][a];
+  memcpy(row + ROW_X, ps->field[SPH_FIELD_POSITION0] + 3 * a, 3 * sizeof *row);
+  memcpy(row + ROW_VEL, ps->field[SPH_FIELD_VELOCITY] + 3 * a, 3 * sizeof *row);
+  memcpy(row + ROW_U, ps->field[SPH_FIELD_DISPLACEMENT] + 3 * a,
+         3 * sizeof *row);
+  memcpy(row + ROW_P, ps->field[SPH_FIELD_PK1] + 9 * a, 9 * sizeof *row);
+  memcpy(row + ROW_F, ps->field[SPH_FIELD_DEFGRAD] + 9 * a, 9 * sizeof *row);
+}
+
+/* one particle's terms added to the sums sv, ev, eP, eu, eg */
+static void error_add(const sph_reference *r, double t, const double *row,
+                      double s[5]) {
+  double uex[3], vex[3], G[9], P[9];
+  const double V = row[ROW_V];
+  exact(r, row + ROW_X, t, uex, vex, G);
+  stress(r, G, P);
+  const double *v = row + ROW_VEL, *u = row + ROW_U, *Pn = row + ROW_P,
+               *Fn = row + ROW_F;
+  for (int i = 0; i < 3; ++i) {
+    s[1] += V * (v[i] - vex[i]) * (v[i] - vex[i]);
+    s[3] += V * (u[i] - uex[i]) * (u[i] - uex[i]);
+  }
+  for (int k = 0; k < 9; ++k) {
+    double dG = Fn[k] - (k % 4 == 0) - G[k]; /* grad u_h = F - I */
+    s[2] += V * (Pn[k] - P[k]) * (Pn[k] - P[k]);
+    s[4] += V * dG * dG;
+  }
+  s[0] += V;
+}
+
+typedef struct {
+  int64_t key;
+  size_t a;
+} keyed;
+
+static int cmp_keyed(const void *pa, const void *pb) {
+  int64_t a = ((const keyed *)pa)->key, b = ((const keyed *)pb)->key;
+  return (a > b) - (a < b);
+}
+
+/* the sums over every particle in storage order: over MPI ranks rank 0
+ * adds the rows of a range of storage indices at a time, received from
+ * their owners, so the sums have the serial bits */
+static sph_status error_sums(const sph_reference *r, const sph_sim *sim,
+                             double s[5], sph_error *err) {
+  enum { RANGE = 1 << 16 };
+  const sph_particles *ps = sim->ps;
+  sph_domain *d = sim->domain;
+  const int64_t *g = sph_domain_storage_index(d);
+  size_t n = ps->n, N = sph_domain_particles(d, ps);
+  int root = sph_domain_rank(d) == 0;
+  keyed *order = malloc((n ? n : 1) * sizeof *order);
+  int64_t *keys = malloc(RANGE * sizeof *keys);
+  double *rows = malloc((size_t)RANGE * ROW_W * sizeof *rows);
+  double *got = root ? malloc((size_t)RANGE * ROW_W * sizeof *got) : NULL;
+  sph_status st = !order || !keys || !rows || (root && !got)
+                      ? sph_error_set(err, SPH_ERR_NOMEM, "reference errors")
+                      : SPH_OK;
+  st = sph_domain_agree(d, st, err);
+  for (size_t a = 0; st == SPH_OK && a < n; ++a)
+    order[a] = (keyed){g ? g[a] : (int64_t)a, a};
+  if (st == SPH_OK && g)
+    qsort(order, n, sizeof *order, cmp_keyed);
+  size_t next = 0;
+  for (size_t lo = 0; st == SPH_OK && lo < N; lo += RANGE) {
+    size_t m = N - lo < RANGE ? N - lo : RANGE, k = 0;
+    for (; next < n && order[next].key < (int64_t)(lo + m); ++next, ++k) {
+      keys[k] = order[next].key;
+      error_row(ps, order[next].a, rows + (size_t)ROW_W * k);
+    }
+    st = sph_domain_gather_range(d, keys, rows, k, ROW_W, (int64_t)lo, m, got,
+                                 err);
+    for (size_t i = 0; st == SPH_OK && root && i < m; ++i)
+      error_add(r, sim->t, got + (size_t)ROW_W * i, s);
+  }
+  free(order);
+  free(keys);
+  free(rows);
+  free(got);
+  return st;
+}
+
+sph_status sph_reference_errors(const sph_reference *r, const sph_sim *sim,
+                                sph_reference_error *e, sph_error *err) {
   e->l2_velocity = e->l2_stress = e->l2_displacement = e->h1_displacement = NAN;
   e->period = e->period_value = e->period_error = NAN;
   e->period_tolerance = r->tolerance;
@@ -334,32 +443,13 @@ void sph_reference_errors(const sph_reference *r, const sph_sim *sim,
       e->period = 2.0 * (r->obs[OBS_LAST] - r->obs[OBS_FIRST]) / (n - 1.0);
       e->period_error = fabs(e->period - r->value) / r->value;
     }
-    return;
+    return SPH_OK;
   }
-  const sph_particles *ps = sim->ps;
-  double sv = 0.0, ev = 0.0, eP = 0.0, eu = 0.0, eg = 0.0;
-  for (size_t a = 0; a < ps->n; ++a) {
-    double uex[3], vex[3], G[9], P[9];
-    const double V = ps->field[SPH_FIELD_VOLUME0][a];
-    exact(r, ps->field[SPH_FIELD_POSITION0] + 3 * a, sim->t, uex, vex, G);
-    stress(r, G, P);
-    const double *v = ps->field[SPH_FIELD_VELOCITY] + 3 * a;
-    const double *u = ps->field[SPH_FIELD_DISPLACEMENT] + 3 * a;
-    const double *Pn = ps->field[SPH_FIELD_PK1] + 9 * a;
-    for (int i = 0; i < 3; ++i) {
-      ev += V * (v[i] - vex[i]) * (v[i] - vex[i]);
-      eu += V * (u[i] - uex[i]) * (u[i] - uex[i]);
-    }
-    const double *Fn = ps->field[SPH_FIELD_DEFGRAD] + 9 * a;
-    for (int k = 0; k < 9; ++k) {
-      double dG = Fn[k] - (k % 4 == 0) - G[k]; /* grad u_h = F - I */
-      eP += V * (Pn[k] - P[k]) * (Pn[k] - P[k]);
-      eg += V * dG * dG;
-    }
-    sv += V;
-  }
-  e->l2_velocity = sqrt(ev / sv) / r->v_amp;
-  e->l2_stress = sqrt(eP / sv) / r->P_amp;
-  e->l2_displacement = sqrt(eu / sv) / r->U0;
-  e->h1_displacement = sqrt(eg / sv) / (r->U0 * M_PI / 2.0);
+  double s[5] = {0.0, 0.0, 0.0, 0.0, 0.0}; /* sv, ev, eP, eu, eg */
+  SPH_TRY(error_sums(r, sim, s, err));
+  e->l2_velocity = sqrt(s[1] / s[0]) / r->v_amp;
+  e->l2_stress = sqrt(s[2] / s[0]) / r->P_amp;
+  e->l2_displacement = sqrt(s[3] / s[0]) / r->U0;
+  e->h1_displacement = sqrt(s[4] / s[0]) / (r->U0 * M_PI / 2.0);
+  return SPH_OK;
 }
