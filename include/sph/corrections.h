@@ -51,6 +51,10 @@ typedef struct sph_cloud {
   const sph_neighbors *nl;
   const sph_kernel *kernel;
   double rcond_min; /* 0 selects the default 1e-10 */
+  /* n flags or NULL: points whose lists may lack neighbours (a distributed
+   * run's images no owned particle neighbours): the functions below give
+   * them NaN values (never to be read) and no failure */
+  const unsigned char *partial;
 } sph_cloud;
 
 /* Per-pair gradients grad[3*k] for every slot k of the CSR list; if not

@@ -82,6 +82,23 @@ static sph_status singular(const sph_cloud *c, long a, const char *what,
                        what, id, x[0], x[1], x[2], nb);
 }
 
+/* Whether point a is partial (sph_cloud.partial): its stride values per
+ * slot, from v, become NaN. */
+static int partial_point(const sph_cloud *c, size_t a, int stride, double *v) {
+  if (!c->partial || !c->partial[a])
+    return 0;
+  for (size_t k = c->nl->offset[a] * (size_t)stride;
+       v && k < c->nl->offset[a + 1] * (size_t)stride; ++k)
+    v[k] = NAN;
+  return 1;
+}
+
+/* NaN to the w values of point a from v (when not NULL) */
+static void nan_values(double *v, size_t a, size_t w) {
+  for (size_t k = 0; v && k < w; ++k)
+    v[w * a + k] = NAN;
+}
+
 /* Zeroes the slots of a particle whose correction failed. */
 static void clear_slots(const sph_neighbors *nl, size_t a, int stride,
                         double *v) {
@@ -284,6 +301,11 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double La[9], gs[3] = {0, 0, 0};
+    if (partial_point(c, (size_t)a, 3, grad)) {
+      nan_values(grad_self, (size_t)a, 3);
+      nan_values(L, (size_t)a, 9);
+      continue;
+    }
     sph_mat3_identity(La);
     if (kind == SPH_GRAD_W1) {
       w1_coef w;
@@ -331,6 +353,10 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double alpha, beta[3] = {0, 0, 0};
+    if (partial_point(c, (size_t)a, 1, w)) {
+      nan_values(wself, (size_t)a, 1);
+      continue;
+    }
     if (order == 0) {
       double S, gam[3];
       shepard(c, (size_t)a, &S, gam);
@@ -490,6 +516,8 @@ sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double sol[4] = {0};
+    if (partial_point(c, (size_t)a, 1, lap))
+      continue;
     if (laplacian_solution(c, (size_t)a, rmin, sol)) {
       mark_bad(&bad, a);
       clear_slots(nl, (size_t)a, 1, lap);
@@ -516,6 +544,10 @@ sph_status sph_correction_coefficients(const sph_cloud *c,
   for (long a = 0; a < n; ++a) {
     double *co = coef + SPH_CORRECTION_COEFS * a;
     int wrong;
+    if (partial_point(c, (size_t)a, 0, NULL)) {
+      nan_values(coef, (size_t)a, SPH_CORRECTION_COEFS);
+      continue;
+    }
     if (kind == SPH_GRAD_W1) {
       w1_coef w;
       wrong = w1_coefficients(c, (size_t)a, rmin, &w) != 0;

@@ -583,7 +583,27 @@ static sph_status rebuild_local(tl_reference *ref, const sph_sim *sim,
   }
   /* ghosts lack part of their neighbourhood: their L comes from the owner */
   size_t whole = ref->n_whole ? ref->n_whole : ref->n_img;
+  /* so may the images of ghosts far from the owned particles: unused */
+  size_t n = ref->n;
+  int flag = sim->domain && !ref->n_whole && ref->n_img > n;
+  if (flag && ref->n_img > ref->partial_cap) { /* grows only */
+    unsigned char *p = realloc(ref->partial, ref->n_img);
+    if (!p)
+      return sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+    ref->partial = p;
+    ref->partial_cap = ref->n_img;
+  }
+  const sph_neighbors *nl = ref->nl;
+  long ni = flag ? (long)ref->n_img : 0;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ni; ++a) {
+    int near = a < (long)n;
+    for (size_t k = nl->offset[a]; !near && k < nl->offset[a + 1]; ++k)
+      near = (size_t)nl->index[k] < n;
+    ref->partial[a] = (unsigned char)!near;
+  }
   sph_cloud cloud = {.n = sim->domain ? whole : ne,
+                     .partial = flag ? ref->partial : NULL,
                      .dim = s->dimension,
                      .x = ref->X,
                      .volume = ref->V,
@@ -736,6 +756,7 @@ void tl_reference_destroy(tl_reference *ref) {
   sph_neighbors_destroy(ref->nl);
   free(ref->id);
   free(ref->w);
+  free(ref->partial);
   free(ref->L);
   free(ref->s);
   free(ref->Qt);

@@ -84,6 +84,10 @@ typedef struct tl_reference {
   /* over MPI ranks: the points from 0 whose lists are whole, so their
    * corrections are computed here (0: n_img) */
   size_t n_whole;
+  /* over MPI ranks with images: the images no owned particle neighbours,
+   * whose lists may lack points the rank does not hold (n_img flags) */
+  unsigned char *partial;
+  size_t partial_cap;
 } tl_reference;
 
 /* Builds everything above in the reference configuration (timed as

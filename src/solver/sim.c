@@ -283,6 +283,9 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)
     st = method->setup(sim, scene->method, err);
+  /* a rank whose set-up failed alone must not leave the others waiting */
+  if (sim->domain)
+    st = sph_domain_agree(sim->domain, st, err);
   if (st == SPH_OK)
     st = check_distributed_terms(sim, err);
   if (st == SPH_OK)

@@ -238,6 +238,7 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
   /* over MPI ranks the ghosts' rows are not whole: their slots toward this
    * rank's particles come from their owners' coefficients (tl_ghost_slots) */
   sph_cloud cloud = {.n = ref->n_img,
+                     .partial = ref->partial,
                      .dim = sim->scene->dimension,
                      .x = ref->X,
                      .volume = ref->V,

@@ -394,6 +394,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   }
   /* over MPI ranks the ghosts' rows are not used (nor complete) */
   sph_cloud cloud = {.n = m->ref.n_img,
+                     .partial = m->ref.partial,
                      .dim = s->dimension,
                      .x = m->ref.X,
                      .volume = m->ref.V,
