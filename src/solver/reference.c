@@ -392,7 +392,7 @@ static int cmp_keyed(const void *pa, const void *pb) {
  * their owners, so the sums have the serial bits */
 static sph_status error_sums(const sph_reference *r, const sph_sim *sim,
                              double s[5], sph_error *err) {
-  enum { RANGE = 1 << 16 };
+  enum { RANGE = 1 << 13 };
   const sph_particles *ps = sim->ps;
   sph_domain *d = sim->domain;
   const int64_t *g = sph_domain_storage_index(d);
