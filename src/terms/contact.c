@@ -13,13 +13,18 @@
  * spring bounds the time step (term_stable_dt).
  *
  * Over MPI ranks (issue 20) a wall acts on each owned particle alone. Pairs
- * of bodies need the dynamic domain of the updated-Lagrangian methods: its
- * ghosts (the other ranks' particles within a kernel support at the last
- * rebuild) carry their current positions, the pair lists are sorted into
- * the serial storage order and only owned particles take a force, so each
- * pair's force is the same bits on both ranks and the serial run's sums
- * are repeated. The ghost layer covers the contact radius while no particle
- * has moved more than (support - r_c) / 2 since the rebuild (checked). */
+ * of bodies take their partners from the other ranks: with the dynamic
+ * domain of the updated-Lagrangian methods its ghosts (the other ranks'
+ * particles within a kernel support at the last rebuild) carry their
+ * current positions, and the ghost layer covers the contact radius while
+ * no particle has moved more than (support - r_c) / 2 since the rebuild
+ * (checked); the total-Lagrangian methods' ghosts are fixed in the
+ * reference configuration, so at every stage each rank sends its particles
+ * near another body to the ranks whose such particles are within the
+ * contact radius (sph_domain_box_points). Either way the pair lists are
+ * sorted into the serial storage order and only owned particles take a
+ * force, so each pair's force is the same bits on both ranks and the
+ * serial run's sums are repeated. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,7 +59,17 @@ typedef struct contact {
   sph_domain *dom;
   double *x_found;
   double slack;
+  /* over MPI ranks with fixed ghosts: the candidates' rows (x, body,
+   * storage index, spacing, modulus, area), the other ranks' received,
+   * and the candidates' keys and constants (cap of each, grown only) */
+  sph_domain *ranks;
+  double *rows, *near;
+  size_t near_cap, cap;
+  int64_t *keyc;
+  double *sc, *mc, *ac;
 } contact;
+
+enum { ROW_BODY = 3, ROW_KEY, ROW_SPACING, ROW_MODULUS, ROW_AREA, ROW_W };
 
 /* A particle of body b within `pad` of the box of another body. */
 static int near_other_body(const contact *ct, const double *x, int b,
@@ -99,6 +114,142 @@ static sph_status ghosts_cover(const contact *ct, const double *x,
                        sqrt(d2max) / ct->radius, ct->slack / ct->radius);
 }
 
+/* the spring of a pair at separation e (r2 = |e|^2) onto f: contact
+ * distance half the sum of spacings, the moduli's harmonic mean, the mean
+ * area */
+static inline void pair_force(double kappa, const double e[3], double r2,
+                              double spacings, double Ma, double Mb,
+                              double areas, double f[3]) {
+  double r = sqrt(r2), rc = 0.5 * spacings;
+  if (!(r < rc) || r == 0.0)
+    return;
+  double M = 2.0 * Ma * Mb / (Ma + Mb);
+  double A = 0.5 * areas;
+  double mag = kappa * M * A * (rc - r) / (rc * r);
+  for (int c = 0; c < 3; ++c)
+    f[c] += mag * e[c];
+}
+
+/* the boxes of the bodies at positions x of points [0, n) (over MPI ranks
+ * with fixed ghosts, of every rank's owned particles) */
+static void body_boxes(contact *ct, const double *x, const int32_t *body,
+                       size_t n) {
+  for (int b = 0; b < ct->nbodies; ++b)
+    for (int c = 0; c < 3; ++c) {
+      ct->box[6 * b + c] = INFINITY;
+      ct->box[6 * b + 3 + c] = -INFINITY;
+    }
+  for (size_t a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c) {
+      double *bx = ct->box + 6 * body[a];
+      bx[c] = fmin(bx[c], x[3 * a + c]);
+      bx[3 + c] = fmax(bx[3 + c], x[3 * a + c]);
+    }
+  for (int k = 0; ct->ranks && k < 6 * ct->nbodies; ++k)
+    ct->box[k] = k % 6 < 3 ? sph_domain_min(ct->ranks, ct->box[k])
+                           : sph_domain_max(ct->ranks, ct->box[k]);
+}
+
+/* room for m candidates (grown only, amortised) */
+static sph_status candidates_room(contact *ct, size_t m, sph_error *err) {
+  if (m <= ct->cap)
+    return SPH_OK;
+  size_t cap = 2 * m;
+  void *p[7] = {realloc(ct->cand, cap * sizeof *ct->cand),
+                NULL,
+                NULL,
+                NULL,
+                NULL,
+                NULL,
+                NULL};
+  if (p[0])
+    ct->cand = p[0];
+  if ((p[1] = realloc(ct->xc, 3 * cap * sizeof *ct->xc)))
+    ct->xc = p[1];
+  if ((p[2] = realloc(ct->bc, cap * sizeof *ct->bc)))
+    ct->bc = p[2];
+  if ((p[3] = realloc(ct->keyc, cap * sizeof *ct->keyc)))
+    ct->keyc = p[3];
+  if ((p[4] = realloc(ct->sc, cap * sizeof *ct->sc)))
+    ct->sc = p[4];
+  if ((p[5] = realloc(ct->mc, cap * sizeof *ct->mc)))
+    ct->mc = p[5];
+  if ((p[6] = realloc(ct->ac, cap * sizeof *ct->ac)))
+    ct->ac = p[6];
+  for (int k = 0; k < 7; ++k)
+    if (!p[k])
+      return sph_error_set(err, SPH_ERR_NOMEM, "contact candidates");
+  ct->cap = cap;
+  return SPH_OK;
+}
+
+/* over MPI ranks with fixed ghosts: the owned particles near another body
+ * and the other ranks' within the contact radius of them, their pair
+ * forces into dp (owned ones) */
+static sph_status between_ranks(contact *ct, const sph_sim *sim,
+                                sph_stage *stage, sph_error *err) {
+  const double *x = stage->x;
+  const int32_t *body = sim->ps->body;
+  const int64_t *gidx = sph_domain_storage_index(ct->ranks);
+  body_boxes(ct, x, body, ct->n);
+  size_t nc = 0;
+  for (size_t a = 0; a < ct->n; ++a)
+    if (near_other_body(ct, x + 3 * a, body[a], ct->radius)) {
+      double *r = ct->rows + (size_t)ROW_W * nc++;
+      memcpy(r, x + 3 * a, 3 * sizeof *r);
+      r[ROW_BODY] = body[a];
+      r[ROW_KEY] = (double)gidx[a];
+      r[ROW_SPACING] = ct->spacing[a];
+      r[ROW_MODULUS] = ct->modulus[a];
+      r[ROW_AREA] = ct->area[a];
+      ct->cand[nc - 1] = a;
+    }
+  size_t m = 0;
+  SPH_TRY(sph_domain_box_points(ct->ranks, ct->rows, nc, ROW_W, ct->radius,
+                                &ct->near, &ct->near_cap, &m, err));
+  sph_status st = candidates_room(ct, nc + m, err);
+  SPH_TRY(sph_domain_agree(ct->ranks, st, err));
+  for (size_t i = 0; i < nc + m; ++i) {
+    const double *r =
+        i < nc ? ct->rows + (size_t)ROW_W * i : ct->near + ROW_W * (i - nc);
+    memcpy(ct->xc + 3 * i, r, 3 * sizeof *r);
+    ct->bc[i] = (int32_t)r[ROW_BODY];
+    ct->keyc[i] = (int64_t)r[ROW_KEY];
+    ct->sc[i] = r[ROW_SPACING];
+    ct->mc[i] = r[ROW_MODULUS];
+    ct->ac[i] = r[ROW_AREA];
+  }
+  st = nc + m < 2
+           ? SPH_OK
+           : sph_neighbors_build(ct->nl, ct->xc, nc + m, ct->dim, ct->radius,
+                                 ct->bc, SPH_PAIRS_OTHER_BODY, err);
+  SPH_TRY(sph_domain_agree(ct->ranks, st, err));
+  if (nc == 0 || nc + m < 2)
+    return SPH_OK;
+  const sph_neighbors *nl = ct->nl;
+  sph_domain_sort_lists_by(ct->nl, nc, ct->keyc);
+  const double kappa = ct->kappa, *xc = ct->xc;
+  double *dp = stage->dp;
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < nc; ++i) {
+    double f[3] = {0, 0, 0};
+    for (size_t s = nl->offset[i]; s < nl->offset[i + 1]; ++s) {
+      size_t j = (size_t)nl->index[s];
+      double e[3], r2 = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        e[c] = xc[3 * i + c] - xc[3 * j + c];
+        r2 += e[c] * e[c];
+      }
+      pair_force(kappa, e, r2, ct->sc[i] + ct->sc[j], ct->mc[i], ct->mc[j],
+                 ct->ac[i] + ct->ac[j], f);
+    }
+    size_t a = ct->cand[i];
+    for (int c = 0; c < 3; ++c)
+      dp[3 * a + c] += ct->inv_mass[a] * f[c];
+  }
+  return SPH_OK;
+}
+
 /* the pair forces of particles near another body, into dp (owned ones) */
 static sph_status between_bodies(contact *ct, const sph_sim *sim,
                                  sph_stage *stage, sph_error *err) {
@@ -106,17 +257,7 @@ static sph_status between_bodies(contact *ct, const sph_sim *sim,
   const int32_t *body = sim->ps->body;
   if (ct->dom)
     SPH_TRY(ghosts_cover(ct, x, err));
-  for (int b = 0; b < ct->nbodies; ++b)
-    for (int c = 0; c < 3; ++c) {
-      ct->box[6 * b + c] = INFINITY;
-      ct->box[6 * b + 3 + c] = -INFINITY;
-    }
-  for (size_t a = 0; a < ct->ne; ++a)
-    for (int c = 0; c < 3; ++c) {
-      double *bx = ct->box + 6 * body[a];
-      bx[c] = fmin(bx[c], x[3 * a + c]);
-      bx[3 + c] = fmax(bx[3 + c], x[3 * a + c]);
-    }
+  body_boxes(ct, x, body, ct->ne);
   size_t nc = 0;
   for (size_t a = 0; a < ct->ne; ++a)
     if (near_other_body(ct, x + 3 * a, body[a], ct->radius)) {
@@ -153,15 +294,8 @@ static sph_status between_bodies(contact *ct, const sph_sim *sim,
         e[c] = x[3 * a + c] - x[3 * b + c];
         r2 += e[c] * e[c];
       }
-      double r = sqrt(r2), rc = 0.5 * (ct->spacing[a] + ct->spacing[b]);
-      if (!(r < rc) || r == 0.0)
-        continue;
-      double M = 2.0 * ct->modulus[a] * ct->modulus[b] /
-                 (ct->modulus[a] + ct->modulus[b]);
-      double A = 0.5 * (ct->area[a] + ct->area[b]);
-      double mag = kappa * M * A * (rc - r) / (rc * r);
-      for (int c = 0; c < 3; ++c)
-        f[c] += mag * e[c];
+      pair_force(kappa, e, r2, ct->spacing[a] + ct->spacing[b], ct->modulus[a],
+                 ct->modulus[b], ct->area[a] + ct->area[b], f);
     }
     for (int c = 0; c < 3; ++c)
       dp[3 * a + c] += ct->inv_mass[a] * f[c];
@@ -192,7 +326,9 @@ static sph_status contact_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
       }
     }
   }
-  if (ct->between)
+  if (ct->ranks)
+    SPH_TRY(between_ranks(ct, sim, stage, err));
+  else if (ct->between)
     SPH_TRY(between_bodies(ct, sim, stage, err));
   return SPH_OK;
 }
@@ -250,6 +386,12 @@ static void contact_destroy(sph_term *term) {
   free(ct->xc);
   free(ct->bc);
   free(ct->x_found);
+  free(ct->rows);
+  free(ct->near);
+  free(ct->keyc);
+  free(ct->sc);
+  free(ct->mc);
+  free(ct->ac);
   sph_neighbors_destroy(ct->nl);
   free(ct);
 }
@@ -264,26 +406,9 @@ static const sph_term_ops contact_ops = {
     .destroy = contact_destroy,
 };
 
-/* Pairs of bodies over ranks need ghosts that follow the current positions:
- * the fixed reference ghosts of the total-Lagrangian methods do not. */
-static sph_status refuse_fixed_ghosts(const sph_sim *sim, sph_error *err) {
-  const sph_node *root = sim->scene->root, *c = sph_node_child(root, "contact");
-  const sph_node *key = c ? sph_node_child(c, "between_bodies") : NULL;
-  return sph_node_error(
-      key ? key : root, err, SPH_ERR_UNSUPPORTED,
-      "contact between bodies does not run over MPI ranks with %s (its "
-      "ghosts are fixed in the reference configuration and do not follow "
-      "the bodies); ul-csph runs it over ranks (--set 'method={name: "
-      "ul-csph}'), or run without mpirun",
-      sim->method->name);
-}
-
 sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_particles *ps = sim->ps;
-  if (sim->domain && s->contact.between_bodies &&
-      sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
-    return refuse_fixed_ghosts(sim, err);
   /* room for every particle a rank may hold after migrations */
   const size_t cap = sph_domain_capacity(sim->domain, ps), nn = cap ? cap : 1;
   contact *ct = calloc(1, sizeof *ct);
@@ -296,8 +421,12 @@ sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
   ct->per_volume = rho0 != NULL;
   ct->between = s->contact.between_bodies;
   ct->nbodies = (int)s->nbodies;
-  if (ct->between && sim->domain)
+  /* the dynamic domain's ghosts follow the bodies, fixed ones do not */
+  if (ct->between && sim->domain &&
+      sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC)
     ct->dom = sim->domain;
+  else if (ct->between && sim->domain)
+    ct->ranks = sim->domain;
   ct->inv_mass = malloc(nn * sizeof *ct->inv_mass);
   ct->modulus = malloc(nn * sizeof *ct->modulus);
   ct->area = malloc(nn * sizeof *ct->area);
@@ -335,7 +464,17 @@ sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
     ct->cand = malloc(nn * sizeof *ct->cand);
     ct->xc = malloc(3 * nn * sizeof *ct->xc);
     ct->bc = malloc(nn * sizeof *ct->bc);
-    st = !ct->box || !ct->cand || !ct->xc || !ct->bc
+    ct->cap = nn;
+    if (ct->ranks) {
+      ct->rows = malloc((size_t)ROW_W * nn * sizeof *ct->rows);
+      ct->keyc = malloc(nn * sizeof *ct->keyc);
+      ct->sc = malloc(nn * sizeof *ct->sc);
+      ct->mc = malloc(nn * sizeof *ct->mc);
+      ct->ac = malloc(nn * sizeof *ct->ac);
+    }
+    st = !ct->box || !ct->cand || !ct->xc || !ct->bc ||
+                 (ct->ranks &&
+                  (!ct->rows || !ct->keyc || !ct->sc || !ct->mc || !ct->ac))
              ? sph_error_set(err, SPH_ERR_NOMEM, "contact")
              : sph_neighbors_create(&ct->nl, err);
     /* room for the searches of the time steps, made here: every pair of
