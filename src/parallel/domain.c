@@ -1184,15 +1184,6 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   return share_create(out, ps, gidx, N, support, dynamic, NULL, 0, err);
 }
 
-sph_status sph_domain_create_share_mirrored(sph_domain **out,
-                                            sph_particles **ps,
-                                            const int64_t *gidx, size_t N,
-                                            double support,
-                                            const sph_domain_plane *planes,
-                                            int nplanes, sph_error *err) {
-  return share_create(out, ps, gidx, N, support, 0, planes, nplanes, err);
-}
-
 /* rank 0's whole set: the creation fields of every rank's owned particles
  * at their storage indices (collective) */
 sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
@@ -1637,16 +1628,6 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   return sph_domain_create(out, ps, support, err);
 }
 
-sph_status sph_domain_create_share_mirrored(sph_domain **out,
-                                            sph_particles **ps,
-                                            const int64_t *gidx, size_t N,
-                                            double support,
-                                            const sph_domain_plane *planes,
-                                            int nplanes, sph_error *err) {
-  (void)gidx, (void)N, (void)planes, (void)nplanes;
-  return sph_domain_create(out, ps, support, err);
-}
-
 sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
                                    sph_error *err) {
   (void)d, (void)ps, (void)err;
@@ -1719,6 +1700,20 @@ sph_status sph_domain_fetch(sph_domain *d, const int64_t *want, size_t nwant,
 }
 
 #endif
+
+sph_status sph_domain_create_share_mirrored(sph_domain **out,
+                                            sph_particles **ps,
+                                            const int64_t *gidx, size_t N,
+                                            double support,
+                                            const sph_domain_plane *planes,
+                                            int nplanes, sph_error *err) {
+#ifdef SPH_HAVE_MPI
+  return share_create(out, ps, gidx, N, support, 0, planes, nplanes, err);
+#else
+  (void)gidx, (void)N, (void)planes, (void)nplanes;
+  return sph_domain_create(out, ps, support, err);
+#endif
+}
 
 /* ascending storage index within each list: insertion sort of the usual
  * few tens of entries */
