@@ -131,6 +131,12 @@ static int differences(const char *text, double support, int dynamic) {
   return all;
 }
 
+/* the fixed and the dynamic domain: the same on every rank */
+static void same_both(const char *text, double support) {
+  ck_assert_int_eq(differences(text, support, 0), 0);
+  ck_assert_int_eq(differences(text, support, 1), 0);
+}
+
 START_TEST(column_3d) {
   const char *scene = SPH_TEST_SCENE_HEAD(
       3) "  - name: column\n"
@@ -144,8 +150,7 @@ START_TEST(column_3d) {
          "  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: "
          "true}\n";
   /* the support of h = 1.3 dp, wendland: 2.6 dp */
-  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0, 0), 0);
-  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0, 1), 0);
+  same_both(scene, 2.6 * 1.0 / 6.0);
 }
 END_TEST
 
@@ -157,8 +162,7 @@ START_TEST(ring_2d) {
          "outer_radius: 0.35}}\n"
          "    particles: {spacing: 0.01, distribution: jitter, seed: 5}\n"
          "    initial_velocity: {uniform: [1, 0, 0]}\n";
-  ck_assert_int_eq(differences(scene, 0.026, 0), 0);
-  ck_assert_int_eq(differences(scene, 0.026, 1), 0);
+  same_both(scene, 0.026);
 }
 END_TEST
 
@@ -174,8 +178,7 @@ START_TEST(bodies_3d) {
          "0.3, length: 0.5}}\n"
          "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
          "    initial_velocity: {uniform: [0, -1, 0]}\n";
-  ck_assert_int_eq(differences(scene, 0.26, 0), 0);
-  ck_assert_int_eq(differences(scene, 0.26, 1), 0);
+  same_both(scene, 0.26);
 }
 END_TEST
 
@@ -252,8 +255,7 @@ START_TEST(punch_2d) {
   /* (on 4 ranks a rank would hold more ghosts than particles) */
   if (sph_domain_world_size() > 3)
     return;
-  ck_assert_int_eq(differences(scene, 2.6 * 0.001, 0), 0);
-  ck_assert_int_eq(differences(scene, 2.6 * 0.001, 1), 0);
+  same_both(scene, 2.6 * 0.001);
 }
 END_TEST
 
@@ -274,8 +276,7 @@ START_TEST(oblique_2d) {
          "skew_symmetry: {axis: x}}\n"
          "  - {name: b13, select: {plane: {axis: y, at: 2, body: plate}}, "
          "skew_symmetry: {axis: y}}\n";
-  ck_assert_int_eq(differences(scene, 0.13, 0), 0);
-  ck_assert_int_eq(differences(scene, 0.13, 1), 0);
+  same_both(scene, 0.13);
 }
 END_TEST
 
