@@ -78,6 +78,16 @@ sph_status sph_domain_create_mirrored(sph_domain **out, sph_particles **ps,
                                       double support,
                                       const sph_domain_plane *planes,
                                       int nplanes, sph_error *err);
+/* sph_domain_create_mirrored from each rank's share (as
+ * sph_domain_create_share): the same owned sets, ghosts (in their order)
+ * and halo, with each rank's reflected boxes exchanged instead of a search
+ * over the whole set. Collective. */
+sph_status sph_domain_create_share_mirrored(sph_domain **out,
+                                            sph_particles **ps,
+                                            const int64_t *gidx, size_t N,
+                                            double support,
+                                            const sph_domain_plane *planes,
+                                            int nplanes, sph_error *err);
 /* Storage indices in the whole set of the owned particles, then of the
  * ghosts (NULL for NULL). */
 const int64_t *sph_domain_storage_index(const sph_domain *d);

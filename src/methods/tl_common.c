@@ -125,26 +125,12 @@ static sph_status rotate_points(void *base, size_t w, size_t n, size_t ng,
   return SPH_OK;
 }
 
-/* Real points first, then images of every point within two supports of a
- * plane on its domain side; two passes over the planes complete edges,
- * corners and periodic images, duplicates are skipped. Images across
- * coordinate planes flip signs; with an oblique plane every point carries
- * its reflection as a matrix (chosen once here). Over MPI ranks the real
- * points are the owned particles and the ghosts, visited in the serial
- * storage order, so the images of both come in the serial images' order
- * (key); the ghosts then move behind the images. */
-static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
-                               sph_error *err) {
-  const sph_scene *s = sim->scene;
-  const sph_particles *ps = sim->ps;
-  const double *X0 = ps->field[SPH_FIELD_POSITION0];
-  sph_domain *dom = sim->domain;
-  size_t n = ps->n, cap = 0;
-  /* other ranks' particles within a support of ours (and of our images) */
-  size_t ng = sph_domain_ghosts(dom), nr = n + ng;
-  plane planes[32];
-  int np = 0, oblique = 0;
-  for (size_t k = 0; images && k < s->nboundaries && np < 32; ++k) {
+/* The scene's symmetry and skew-symmetry planes (at most 32) into planes:
+ * their count; *oblique when one is not a coordinate plane. */
+static int scene_planes(const sph_scene *s, plane *planes, int *oblique) {
+  int np = 0;
+  *oblique = 0;
+  for (size_t k = 0; k < s->nboundaries && np < 32; ++k) {
     const sph_boundary *bc = &s->boundaries[k];
     if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
       continue;
@@ -155,9 +141,21 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     pl->body = bc->select.body;
     pl->sigma = bc->kind == SPH_BC_SYMMETRY ? 1 : -1;
     pl->done = 0;
-    oblique |= pl->axis < 0;
-    double mean[2] = {0.0, 0.0}; /* over the whole body: every rank's */
-    for (size_t a = 0; a < n; ++a)
+    pl->side = 1;
+    *oblique |= pl->axis < 0;
+  }
+  return np;
+}
+
+/* Each plane's domain side: that of the mean distance of its body's
+ * particles (over every rank's). */
+static void plane_sides(plane *planes, int np, const sph_particles *ps,
+                        sph_domain *dom) {
+  const double *X0 = ps->field[SPH_FIELD_POSITION0];
+  for (int k = 0; k < np; ++k) {
+    plane *pl = &planes[k];
+    double mean[2] = {0.0, 0.0};
+    for (size_t a = 0; a < ps->n; ++a)
       if (pl->body < 0 || ps->body[a] == pl->body) {
         mean[0] += plane_distance(pl, X0 + 3 * a);
         mean[1] += 1.0;
@@ -165,6 +163,34 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
     sph_domain_sum(dom, mean, 2);
     pl->side = mean[1] > 0.0 && mean[0] / mean[1] < 0.0 ? -1 : 1;
   }
+}
+
+/* Real points first, then images of every point within two supports of a
+ * plane on its domain side; two passes over the planes complete edges,
+ * corners and periodic images, duplicates are skipped. Images across
+ * coordinate planes flip signs; with an oblique plane every point carries
+ * its reflection as a matrix (chosen once here). Over MPI ranks the real
+ * points are the owned particles and the ghosts, visited in the serial
+ * storage order, so the images of both come in the serial images' order
+ * (key); the ghosts then move behind the images. The planes' sides are
+ * side[k] when given (the whole set's for a part of it), else from
+ * plane_sides. */
+static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
+                               const int *side, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  const sph_particles *ps = sim->ps;
+  const double *X0 = ps->field[SPH_FIELD_POSITION0];
+  sph_domain *dom = sim->domain;
+  size_t n = ps->n, cap = 0;
+  /* other ranks' particles within a support of ours (and of our images) */
+  size_t ng = sph_domain_ghosts(dom), nr = n + ng;
+  plane planes[32];
+  int oblique = 0, np = images ? scene_planes(s, planes, &oblique) : 0;
+  if (side)
+    for (int k = 0; k < np; ++k)
+      planes[k].side = side[k];
+  else
+    plane_sides(planes, np, ps, dom);
   SPH_TRY(grow_points(r, nr + 1, &cap, oblique, err));
   memcpy(r->X, X0, 3 * n * sizeof(double));
   memcpy(r->V, ps->field[SPH_FIELD_VOLUME0], n * sizeof(double));
@@ -326,53 +352,79 @@ static sph_status build_images(tl_reference *r, sph_sim *sim, int images,
   return SPH_OK;
 }
 
-/* Over MPI ranks with a dynamic domain: the serial images built over the
- * whole set (gathered), kept as r->all_images; the local points are the
- * owned particles, with room for the images the method places. */
+static int cmp_row(const void *pa, const void *pb) {
+  const int64_t *a = pa, *b = pb;
+  return (a[0] > b[0]) - (a[0] < b[0]);
+}
+
+/* Over MPI ranks with a dynamic domain: the serial images, kept as
+ * r->all_images, built over the real points within four supports of a
+ * plane, gathered from every rank in storage order (the images' sources lie
+ * within two, the real points an image could coincide with within two and
+ * a rounding; the planes' sides are the whole set's); the local points are
+ * the owned particles, with room for the images the method places. */
 static sph_status build_images_dynamic(tl_reference *r, sph_sim *sim,
                                        sph_error *err) {
   sph_particles *ps = sim->ps;
   sph_domain *dom = sim->domain;
+  const double *X0 = ps->field[SPH_FIELD_POSITION0];
+  const int64_t *gidx = sph_domain_storage_index(dom);
   size_t n = ps->n;
   double count = (double)n;
   sph_domain_sum(dom, &count, 1);
   size_t N = (size_t)count;
-  double *mine = malloc((5 * n + 1) * sizeof *mine);
-  double *all = malloc((5 * N + 1) * sizeof *all);
-  sph_particles *full = NULL;
+  plane planes[32];
+  int side[32], oblique = 0, np = scene_planes(sim->scene, planes, &oblique);
+  plane_sides(planes, np, ps, dom);
+  for (int k = 0; k < np; ++k)
+    side[k] = planes[k].side;
+  /* rows of 6 words: storage index, then the bits of X, V and the body */
+  double near = 4.0 * sim->kernel.support;
+  int64_t *mine = malloc((6 * n + 1) * sizeof *mine), *all = NULL;
+  size_t m = 0, total = 0;
+  sph_particles *part = NULL;
   tl_reference g = {0};
   tl_images *t = calloc(1, sizeof *t);
-  sph_status st = mine && all && t
-                      ? SPH_OK
-                      : sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
+  sph_status st =
+      mine && t ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
   for (size_t a = 0; st == SPH_OK && a < n; ++a) {
-    memcpy(mine + 5 * a, ps->field[SPH_FIELD_POSITION0] + 3 * a,
-           3 * sizeof *mine);
-    mine[5 * a + 3] = ps->field[SPH_FIELD_VOLUME0][a];
-    mine[5 * a + 4] = (double)ps->body[a];
+    int in = 0;
+    for (int k = 0; k < np; ++k)
+      in |= fabs(plane_distance(&planes[k], X0 + 3 * a)) < near;
+    if (!in)
+      continue;
+    int64_t *row = mine + 6 * m++;
+    row[0] = gidx[a];
+    memcpy(row + 1, X0 + 3 * a, 3 * sizeof *row);
+    memcpy(row + 4, ps->field[SPH_FIELD_VOLUME0] + a, sizeof *row);
+    row[5] = ps->body[a];
+  }
+  st = sph_domain_agree(dom, st, err);
+  if (st == SPH_OK)
+    st = sph_domain_allgather_i64(dom, mine, 6 * m, &all, &total, NULL, err);
+  size_t P = total / 6;
+  if (st == SPH_OK) {
+    qsort(all, P, 6 * sizeof *all, cmp_row);
+    st = sph_particles_create(&part, P, ps->dim, err);
   }
   if (st == SPH_OK)
-    st = sph_domain_allgather(dom, mine, 5, all, err);
+    st = sph_particles_require(part, SPH_FIELD_POSITION0, err);
   if (st == SPH_OK)
-    st = sph_particles_create(&full, N, ps->dim, err);
-  if (st == SPH_OK)
-    st = sph_particles_require(full, SPH_FIELD_POSITION0, err);
-  if (st == SPH_OK)
-    st = sph_particles_require(full, SPH_FIELD_VOLUME0, err);
+    st = sph_particles_require(part, SPH_FIELD_VOLUME0, err);
   if (st == SPH_OK) {
-    full->n = N;
-    for (size_t i = 0; i < N; ++i) {
-      memcpy(full->field[SPH_FIELD_POSITION0] + 3 * i, all + 5 * i,
+    part->n = P;
+    for (size_t i = 0; i < P; ++i) {
+      memcpy(part->field[SPH_FIELD_POSITION0] + 3 * i, all + 6 * i + 1,
              3 * sizeof *all);
-      full->field[SPH_FIELD_VOLUME0][i] = all[5 * i + 3];
-      full->body[i] = (int32_t)all[5 * i + 4];
+      memcpy(part->field[SPH_FIELD_VOLUME0] + i, all + 6 * i + 4, sizeof *all);
+      part->body[i] = (int32_t)all[6 * i + 5];
     }
     sph_sim serial = *sim; /* the serial run's images */
-    serial.ps = full;
+    serial.ps = part;
     serial.domain = NULL;
-    st = build_images(&g, &serial, 1, err);
+    st = build_images(&g, &serial, 1, side, err);
   }
-  size_t M = st == SPH_OK ? g.n_img - N : 0;
+  size_t M = st == SPH_OK ? g.n_img - P : 0;
   int *per = NULL;
   if (st == SPH_OK) {
     t->m = M;
@@ -383,14 +435,14 @@ static sph_status build_images_dynamic(tl_reference *r, sph_sim *sim,
     t->ssign = malloc(M + 1);
     t->X = malloc((3 * M + 1) * sizeof *t->X);
     t->vmat = g.vmat ? malloc((9 * M + 1) * sizeof *t->vmat) : NULL;
-    per = calloc(N + 1, sizeof *per);
+    per = calloc(P + 1, sizeof *per);
     if (!t->src || !t->vsign || !t->rsign || !t->ssign || !t->X || !per ||
         (g.vmat && !t->vmat))
       st = sph_error_set(err, SPH_ERR_NOMEM, "mirror images");
   }
   for (size_t j = 0; st == SPH_OK && j < M; ++j) {
-    size_t i = N + j;
-    t->src[j] = g.src[i];
+    size_t i = P + j;
+    t->src[j] = (int32_t)all[6 * (size_t)g.src[i]];
     memcpy(t->vsign + 3 * j, g.vsign + 3 * i, 3);
     memcpy(t->rsign + 3 * j, g.rsign + 3 * i, 3);
     t->ssign[j] = g.ssign[i];
@@ -403,11 +455,11 @@ static sph_status build_images_dynamic(tl_reference *r, sph_sim *sim,
   free(per);
   free(mine);
   free(all);
-  sph_particles_destroy(full);
+  sph_particles_destroy(part);
   tl_reference_destroy(&g);
   r->all_images = t;
   SPH_TRY(st);
-  SPH_TRY(build_images(r, sim, 0, err));
+  SPH_TRY(build_images(r, sim, 0, NULL, err));
   size_t cap = 0;
   r->cap += M;
   SPH_TRY(grow_points(r, r->cap, &cap, t->vmat != NULL, err));
@@ -658,7 +710,7 @@ sph_status tl_reference_create(tl_reference *ref, sph_sim *sim, int images,
   if (planes && sph_domain_migrates(sim->domain))
     SPH_TRY(build_images_dynamic(ref, sim, err));
   else
-    SPH_TRY(build_images(ref, sim, images, err));
+    SPH_TRY(build_images(ref, sim, images, NULL, err));
   size_t n = ref->n, ne = ref->n_ext;
   if (ref->n_img > n)
     sim->mirror = &ref->mirror;

@@ -945,59 +945,105 @@ static int in_box(const double *box, const double X[3], int dim, double w) {
   return in;
 }
 
+/* whether X lies in one of the nb boxes b widened by w (all: every X) */
+static int in_boxes(const double *b, size_t nb, int all, const double X[3],
+                    int dim, double w) {
+  for (size_t k = 0; !all && k < nb; ++k)
+    all = in_box(b + 6 * k, X, dim, w);
+  return all;
+}
+
 /* each rank's owned records to the ranks whose owned box, widened by
- * `support`, holds them (collective) */
+ * `support`, holds them; with planes, to those whose box or one of its
+ * reflections (find_mirror_ghosts' boxes), widened by two supports, holds
+ * them (collective) */
 static sph_status share_candidates(share_rec *own, size_t n, int dim,
-                                   double support, MPI_Datatype type,
-                                   share_rec **cand, size_t *nc,
-                                   sph_error *err) {
+                                   double support,
+                                   const sph_domain_plane *planes, int np,
+                                   MPI_Datatype type, share_rec **cand,
+                                   size_t *nc, sph_error *err) {
   int R = world_size;
-  double box[6] = {INFINITY,  INFINITY,  INFINITY,
-                   -INFINITY, -INFINITY, -INFINITY};
+  size_t max = np ? SPH_DOMAIN_MIRROR_BOXES : 1;
+  double *box = malloc(6 * max * sizeof *box);
+  int *nbox = malloc((4 * (size_t)R + 1) * sizeof *nbox);
+  int *count = calloc((size_t)R, sizeof *count);
+  int ok = box && nbox && count, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (!all) {
+    free(box);
+    free(nbox);
+    free(count);
+    return sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  }
+  for (int c = 0; c < 3; ++c)
+    box[c] = INFINITY, box[3 + c] = -INFINITY;
   for (size_t a = 0; a < n; ++a)
     for (int c = 0; c < dim; ++c) {
       box[c] = fmin(box[c], own[a].X[c]);
       box[3 + c] = fmax(box[3 + c], own[a].X[c]);
     }
-  double *boxes = malloc(6 * (size_t)R * sizeof *boxes);
-  int *count = calloc((size_t)R, sizeof *count);
-  int ok = boxes && count, all = 0;
-  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  if (!all) {
-    free(boxes);
-    free(count);
-    return sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
+  for (int c = dim; np && c < 3; ++c)
+    box[c] = box[3 + c] = 0.0;
+  /* the boxes' count and whether they settled (else: every particle) */
+  int mine[2] = {1, 0};
+  if (np) {
+    size_t nb = sph_domain_mirror_boxes(planes, np, 4.0 * support,
+                                        1e-9 * support, 16, box, max);
+    mine[0] = nb ? (int)nb : 1;
+    mine[1] = nb == 0;
   }
-  MPI_Allgather(box, 6, MPI_DOUBLE, boxes, 6, MPI_DOUBLE, MPI_COMM_WORLD);
+  int *cnt = nbox + 2 * R, *off = cnt + R; /* 2 R, R, R + 1 */
+  MPI_Allgather(mine, 2, MPI_INT, nbox, 2, MPI_INT, MPI_COMM_WORLD);
+  off[0] = 0;
+  for (int q = 0; q < R; ++q) {
+    cnt[q] = 6 * nbox[2 * q];
+    off[q + 1] = off[q] + cnt[q];
+  }
+  double *boxes = malloc(((size_t)off[R] + 1) * sizeof *boxes);
+  ok = boxes != NULL;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (all)
+    MPI_Allgatherv(box, 6 * mine[0], MPI_DOUBLE, boxes, cnt, off, MPI_DOUBLE,
+                   MPI_COMM_WORLD);
+  free(box);
+  double w = np ? 2.0 * support : support;
   size_t total = 0;
-  for (int q = 0; q < R; ++q)
-    for (size_t a = 0; q != world_rank && a < n; ++a)
-      if (in_box(boxes + 6 * q, own[a].X, dim, support))
-        count[q]++, own[a].edge = 1;
-  for (int q = 0; q < R; ++q)
-    total += (size_t)count[q];
+  for (int q = 0; all && q < R; ++q)
+    for (size_t a = 0; q != world_rank && a < n; ++a) {
+      const double *b = boxes + off[q];
+      /* pairs with the rank's own particles: within its box */
+      if (in_box(b, own[a].X, dim, support))
+        own[a].edge = 1;
+      if (in_boxes(b, (size_t)nbox[2 * q], nbox[2 * q + 1], own[a].X, dim, w))
+        count[q]++, total++;
+    }
   share_rec *send = malloc((total ? total : 1) * sizeof *send);
-  ok = send != NULL;
+  ok = all && send != NULL;
   MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   sph_status st =
       all ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "ghost search");
   size_t k = 0;
   for (int q = 0; st == SPH_OK && q < R; ++q)
     for (size_t a = 0; q != world_rank && a < n; ++a)
-      if (in_box(boxes + 6 * q, own[a].X, dim, support))
+      if (in_boxes(boxes + off[q], (size_t)nbox[2 * q], nbox[2 * q + 1],
+                   own[a].X, dim, w))
         send[k++] = own[a];
   if (st == SPH_OK)
     st = send_recs(send, count, type, cand, nc, err);
   free(send);
   free(boxes);
+  free(nbox);
   free(count);
   return st;
 }
 
-sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
-                                   const int64_t *gidx, size_t N,
-                                   double support, int dynamic,
-                                   sph_error *err) {
+/* sph_domain_create_share, with planes sph_domain_create_mirrored's
+ * ghosts: every candidate (each lies in a box of find_mirror_ghosts), the
+ * usefulness check counting those within one support of an owned one */
+static sph_status share_create(sph_domain **out, sph_particles **ps,
+                               const int64_t *gidx, size_t N, double support,
+                               int dynamic, const sph_domain_plane *planes,
+                               int np, sph_error *err) {
   *out = NULL;
   sph_particles *in = *ps;
   size_t m = in->n;
@@ -1072,10 +1118,18 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
       own[a].owner = world_rank;
     /* a dynamic domain finds its ghosts at each rebuild */
     if (!dynamic)
-      st = share_candidates(own, d->n, dim, support, type, &cand, &nc, err);
+      st = share_candidates(own, d->n, dim, support, planes, np, type, &cand,
+                            &nc, err);
   }
   if (st == SPH_OK && !dynamic)
     st = share_ghosts(own, d->n, cand, nc, dim, support, &ghost, &ng, err);
+  size_t ng_support = ng;
+  if (st == SPH_OK && np > 0 && !dynamic) {
+    free(ghost);
+    qsort(cand, nc, sizeof *cand, cmp_rec_owner);
+    ghost = cand, ng = nc;
+    cand = NULL;
+  }
   free(cand);
   if (st == SPH_OK) {
     d->ng = ng;
@@ -1107,7 +1161,7 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   MPI_Type_free(&type);
   st = sph_domain_agree(&world, st, err);
   if (st == SPH_OK)
-    st = halo_plan(d, st, ng, N, gowner, err);
+    st = halo_plan(d, st, ng_support, N, gowner, err);
   free(gowner);
   sph_particles *mine = NULL;
   if (st == SPH_OK)
@@ -1129,6 +1183,13 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   *ps = mine;
   *out = d;
   return SPH_OK;
+}
+
+sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
+                                   const int64_t *gidx, size_t N,
+                                   double support, int dynamic,
+                                   sph_error *err) {
+  return share_create(out, ps, gidx, N, support, dynamic, NULL, 0, err);
 }
 
 /* rank 0's whole set: the creation fields of every rank's owned particles
@@ -1707,6 +1768,20 @@ sph_status sph_domain_gather_range(sph_domain *d, const int64_t *key,
   return SPH_OK;
 }
 #endif
+
+sph_status sph_domain_create_share_mirrored(sph_domain **out,
+                                            sph_particles **ps,
+                                            const int64_t *gidx, size_t N,
+                                            double support,
+                                            const sph_domain_plane *planes,
+                                            int nplanes, sph_error *err) {
+#ifdef SPH_HAVE_MPI
+  return share_create(out, ps, gidx, N, support, 0, planes, nplanes, err);
+#else
+  (void)gidx, (void)N, (void)planes, (void)nplanes;
+  return sph_domain_create(out, ps, support, err);
+#endif
+}
 
 /* ascending storage index within each list: insertion sort of the usual
  * few tens of entries */

@@ -165,10 +165,15 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
    * reflections, as an image's stabilised force matrix reads its
    * neighbours' corrections (methods/ul_csph) */
   if (np && sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
-    SPH_TRY(sph_domain_create_dynamic(&sim->domain, &sim->ps,
-                                      sim->kernel.support, err));
+    SPH_TRY(gidx ? sph_domain_create_share(&sim->domain, &sim->ps, gidx, N,
+                                           sim->kernel.support, 1, err)
+                 : sph_domain_create_dynamic(&sim->domain, &sim->ps,
+                                             sim->kernel.support, err));
     return sph_domain_dyn_mirror(sim->domain, planes, np, 3.0, err);
   }
+  if (gidx && np)
+    return sph_domain_create_share_mirrored(
+        &sim->domain, &sim->ps, gidx, N, sim->kernel.support, planes, np, err);
   if (gidx)
     return sph_domain_create_share(
         &sim->domain, &sim->ps, gidx, N, sim->kernel.support,
@@ -183,16 +188,11 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
 }
 
 /* Whether each rank can build its own share of the particles without the
- * whole set (sph_scene_build_share): no symmetry planes (their mirror
- * ghosts and images come from the whole set), bodies of lattice or jitter
- * points (a relaxation moves the whole body). */
+ * whole set (sph_scene_build_share): bodies of lattice or jitter points (a
+ * relaxation moves the whole body). */
 static int per_rank_setup(const sph_scene *s, const sph_method_ops *method) {
   if (sph_domain_world_size() < 2 || !method->distributed)
     return 0;
-  for (size_t k = 0; k < s->nboundaries; ++k)
-    if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
-        s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY)
-      return 0;
   for (size_t b = 0; b < s->nbodies; ++b)
     if (s->bodies[b].distribution == SPH_DIST_RELAX)
       return 0;

@@ -6,7 +6,11 @@
  * halo plan, and rank 0's whole set (sph_domain_whole_create) the sorted
  * whole set; the same for the updated-Lagrangian (dynamic) domain. 3D face
  * lattice with jitter (a turned column), 2D cells with jitter, two 3D bodies (a
- * block and a punch). Run under mpirun (ctest: 2, 3 and 4 ranks). */
+ * block and a punch). With symmetry and skew-symmetry planes
+ * (sph_domain_create_share_mirrored against sph_domain_create_mirrored,
+ * the ghosts of the planes' images included): the swinging cube's six
+ * coordinate planes, the punch's two (also dynamic), a turned plate's
+ * oblique ones. Run under mpirun (ctest: 2, 3 and 4 ranks). */
 #include "parallel/domain_impl.h"
 
 #include <check.h>
@@ -34,10 +38,28 @@ static int same_set(const sph_particles *a, const sph_particles *b) {
          SAME(a->flags, b->flags, a->n);
 }
 
+/* the scene's symmetry and skew-symmetry planes, as solver/sim.c passes
+ * them */
+static int scene_planes(const sph_scene *s, sph_domain_plane *planes) {
+  int np = 0;
+  for (size_t k = 0; k < s->nboundaries && np < 32; ++k) {
+    const sph_boundary *bc = &s->boundaries[k];
+    if (bc->kind != SPH_BC_SYMMETRY && bc->kind != SPH_BC_SKEW_SYMMETRY)
+      continue;
+    planes[np] =
+        (sph_domain_plane){.at = bc->select.at, .axis = bc->select.axis};
+    memcpy(planes[np++].n, bc->select.normal, sizeof planes->n);
+  }
+  return np;
+}
+
 /* ranks where the two set-ups differ (dynamic: the updated-Lagrangian
- * domain's, owned sets and their room) */
+ * domain's, owned sets and their room; with the scene's planes when it
+ * has some) */
 static int differences(const char *text, double support, int dynamic) {
   sph_scene *s = sph_test_scene_text(text);
+  sph_domain_plane planes[32];
+  int np = scene_planes(s, planes);
   sph_error err;
   sph_particles *whole = NULL, *share = NULL;
   int64_t *gidx = NULL, first;
@@ -65,13 +87,19 @@ static int differences(const char *text, double support, int dynamic) {
   memcpy(sorted->body, whole->body, whole->n * sizeof *whole->body);
   memcpy(sorted->flags, whole->flags, whole->n * sizeof *whole->flags);
   sph_domain *a = NULL, *b = NULL;
-  ck_assert_int_eq(dynamic
-                       ? sph_domain_create_dynamic(&a, &whole, support, &err)
-                       : sph_domain_create(&a, &whole, support, &err),
-                   SPH_OK);
   ck_assert_int_eq(
-      sph_domain_create_share(&b, &share, gidx, N, support, dynamic, &err),
+      dynamic ? sph_domain_create_dynamic(&a, &whole, support, &err)
+      : np ? sph_domain_create_mirrored(&a, &whole, support, planes, np, &err)
+           : sph_domain_create(&a, &whole, support, &err),
       SPH_OK);
+  ck_assert_int_eq(np && !dynamic
+                       ? sph_domain_create_share_mirrored(
+                             &b, &share, gidx, N, support, planes, np, &err)
+                       : sph_domain_create_share(&b, &share, gidx, N, support,
+                                                 dynamic, &err),
+                   SPH_OK);
+  ck_assert_int_eq(sph_domain_dyn_mirror(a, planes, np, 3.0, &err), SPH_OK);
+  ck_assert_int_eq(sph_domain_dyn_mirror(b, planes, np, 3.0, &err), SPH_OK);
   ck_assert_int_eq(sph_domain_whole_create(b, share, &err), SPH_OK);
   int bad = a->n != b->n || a->ng != b->ng || a->nsend != b->nsend ||
             !same_set(whole, share) || whole->capacity != share->capacity ||
@@ -103,6 +131,12 @@ static int differences(const char *text, double support, int dynamic) {
   return all;
 }
 
+/* the fixed and the dynamic domain: the same on every rank */
+static void same_both(const char *text, double support) {
+  ck_assert_int_eq(differences(text, support, 0), 0);
+  ck_assert_int_eq(differences(text, support, 1), 0);
+}
+
 START_TEST(column_3d) {
   const char *scene = SPH_TEST_SCENE_HEAD(
       3) "  - name: column\n"
@@ -116,8 +150,7 @@ START_TEST(column_3d) {
          "  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: "
          "true}\n";
   /* the support of h = 1.3 dp, wendland: 2.6 dp */
-  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0, 0), 0);
-  ck_assert_int_eq(differences(scene, 2.6 * 1.0 / 6.0, 1), 0);
+  same_both(scene, 2.6 * 1.0 / 6.0);
 }
 END_TEST
 
@@ -129,8 +162,7 @@ START_TEST(ring_2d) {
          "outer_radius: 0.35}}\n"
          "    particles: {spacing: 0.01, distribution: jitter, seed: 5}\n"
          "    initial_velocity: {uniform: [1, 0, 0]}\n";
-  ck_assert_int_eq(differences(scene, 0.026, 0), 0);
-  ck_assert_int_eq(differences(scene, 0.026, 1), 0);
+  same_both(scene, 0.026);
 }
 END_TEST
 
@@ -146,8 +178,105 @@ START_TEST(bodies_3d) {
          "0.3, length: 0.5}}\n"
          "    particles: {spacing: 0.1, distribution: jitter, seed: 2}\n"
          "    initial_velocity: {uniform: [0, -1, 0]}\n";
-  ck_assert_int_eq(differences(scene, 0.26, 0), 0);
-  ck_assert_int_eq(differences(scene, 0.26, 1), 0);
+  same_both(scene, 0.26);
+}
+END_TEST
+
+/* the ghosts with planes against those without: more (the images'
+ * sources and neighbourhoods), so the planes reached the search */
+static size_t ghosts_of(const char *text, double support, int mirrored) {
+  sph_scene *s = sph_test_scene_text(text);
+  sph_domain_plane planes[32];
+  int np = mirrored ? scene_planes(s, planes) : 0;
+  sph_error err;
+  sph_particles *share = NULL;
+  int64_t *gidx = NULL, first;
+  size_t N = 0;
+  ck_assert_int_eq(sph_scene_build_share(s, support, sph_domain_world_rank(),
+                                         sph_domain_world_size(), &share, &gidx,
+                                         &N, &first, &err),
+                   SPH_OK);
+  sph_domain *d = NULL;
+  ck_assert_int_eq(sph_domain_create_share_mirrored(&d, &share, gidx, N,
+                                                    support, planes, np, &err),
+                   SPH_OK);
+  double ng = (double)d->ng;
+  sph_domain_sum(d, &ng, 1);
+  sph_domain_destroy(d);
+  sph_particles_destroy(share);
+  free(gidx);
+  sph_scene_destroy(s);
+  return (size_t)ng;
+}
+
+/* the swinging cube (scenes/swinging_cube.yaml) at spacing 1/8 (as
+ * shipped, 2 ranks) and 1/16 */
+#define CUBE(spacing)                                                          \
+  SPH_TEST_SCENE_HEAD(3)                                                       \
+  "  - name: cube\n"                                                           \
+  "    material: m\n"                                                          \
+  "    shape: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"                       \
+  "    particles: {spacing: " spacing "}\n"                                    \
+  "boundaries:\n"                                                              \
+  "  - {name: b1, select: {plane: {axis: x, at: 0}}, symmetry: {axis: x}}\n"   \
+  "  - {name: b2, select: {plane: {axis: y, at: 0}}, symmetry: {axis: y}}\n"   \
+  "  - {name: b3, select: {plane: {axis: z, at: 0}}, symmetry: {axis: z}}\n"   \
+  "  - {name: b4, select: {plane: {axis: x, at: 1}}, skew_symmetry: {axis: "   \
+  "x}}\n"                                                                      \
+  "  - {name: b5, select: {plane: {axis: y, at: 1}}, skew_symmetry: {axis: "   \
+  "y}}\n"                                                                      \
+  "  - {name: b6, select: {plane: {axis: z, at: 1}}, skew_symmetry: {axis: "   \
+  "z}}\n"
+
+START_TEST(swinging_cube) {
+  /* the support of h = 1.3 dp, wendland: 2.6 dp */
+  if (sph_domain_world_size() == 2)
+    ck_assert_int_eq(differences(CUBE("0.125"), 2.6 * 0.125, 0), 0);
+  ck_assert_int_eq(differences(CUBE("0.0625"), 2.6 * 0.0625, 0), 0);
+  ck_assert_uint_gt(ghosts_of(CUBE("0.0625"), 2.6 * 0.0625, 1),
+                    ghosts_of(CUBE("0.0625"), 2.6 * 0.0625, 0));
+}
+END_TEST
+
+START_TEST(punch_2d) {
+  /* scenes/punch_ul_csph.yaml's block and planes */
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      2) "  - name: block\n"
+         "    material: m\n"
+         "    shape: {box: {min: [0, 0], max: [0.03, 0.01]}}\n"
+         "    particles: {count: [31, 11]}\n"
+         "boundaries:\n"
+         "  - {name: b7, select: {plane: {axis: x, at: 0}}, symmetry: {axis: "
+         "x}}\n"
+         "  - {name: b8, select: {plane: {axis: y, at: 0}}, symmetry: {axis: "
+         "y}}\n"
+         "  - {name: b9, select: {plane: {axis: x, at: 0.03}}, roller: {axis: "
+         "x}}\n";
+  /* (on 4 ranks a rank would hold more ghosts than particles) */
+  if (sph_domain_world_size() > 3)
+    return;
+  same_both(scene, 2.6 * 0.001);
+}
+END_TEST
+
+START_TEST(oblique_2d) {
+  /* the swinging plate turned by 30 degrees: its four planes oblique */
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      2) "  - name: plate\n"
+         "    material: m\n"
+         "    shape: {box: {min: [0, 0], max: [2, 2]}}\n"
+         "    particles: {spacing: 0.05, distribution: jitter, seed: 3}\n"
+         "    transform: {rotate: {angle: 30}}\n"
+         "boundaries:\n"
+         "  - {name: b10, select: {plane: {axis: x, at: 0, body: plate}}, "
+         "symmetry: {axis: x}}\n"
+         "  - {name: b11, select: {plane: {axis: y, at: 0, body: plate}}, "
+         "symmetry: {axis: y}}\n"
+         "  - {name: b12, select: {plane: {axis: x, at: 2, body: plate}}, "
+         "skew_symmetry: {axis: x}}\n"
+         "  - {name: b13, select: {plane: {axis: y, at: 2, body: plate}}, "
+         "skew_symmetry: {axis: y}}\n";
+  same_both(scene, 0.13);
 }
 END_TEST
 
@@ -161,6 +290,9 @@ int main(int argc, char **argv) {
   tcase_add_test(t, column_3d);
   tcase_add_test(t, ring_2d);
   tcase_add_test(t, bodies_3d);
+  tcase_add_test(t, swinging_cube);
+  tcase_add_test(t, punch_2d);
+  tcase_add_test(t, oblique_2d);
   suite_add_tcase(s, t);
   return sph_mpi_check_run(s);
 }
