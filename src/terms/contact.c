@@ -150,35 +150,28 @@ static void body_boxes(contact *ct, const double *x, const int32_t *body,
                            : sph_domain_max(ct->ranks, ct->box[k]);
 }
 
-/* room for m candidates (grown only, amortised) */
+/* room for m candidates (grown only, amortised; each array stays as it
+ * was when its growth fails) */
 static sph_status candidates_room(contact *ct, size_t m, sph_error *err) {
   if (m <= ct->cap)
     return SPH_OK;
   size_t cap = 2 * m;
-  void *p[7] = {realloc(ct->cand, cap * sizeof *ct->cand),
-                NULL,
-                NULL,
-                NULL,
-                NULL,
-                NULL,
-                NULL};
-  if (p[0])
-    ct->cand = p[0];
-  if ((p[1] = realloc(ct->xc, 3 * cap * sizeof *ct->xc)))
-    ct->xc = p[1];
-  if ((p[2] = realloc(ct->bc, cap * sizeof *ct->bc)))
-    ct->bc = p[2];
-  if ((p[3] = realloc(ct->keyc, cap * sizeof *ct->keyc)))
-    ct->keyc = p[3];
-  if ((p[4] = realloc(ct->sc, cap * sizeof *ct->sc)))
-    ct->sc = p[4];
-  if ((p[5] = realloc(ct->mc, cap * sizeof *ct->mc)))
-    ct->mc = p[5];
-  if ((p[6] = realloc(ct->ac, cap * sizeof *ct->ac)))
-    ct->ac = p[6];
-  for (int k = 0; k < 7; ++k)
-    if (!p[k])
-      return sph_error_set(err, SPH_ERR_NOMEM, "contact candidates");
+  size_t *cand = realloc(ct->cand, cap * sizeof *cand);
+  ct->cand = cand ? cand : ct->cand;
+  double *xc = realloc(ct->xc, 3 * cap * sizeof *xc);
+  ct->xc = xc ? xc : ct->xc;
+  int32_t *bc = realloc(ct->bc, cap * sizeof *bc);
+  ct->bc = bc ? bc : ct->bc;
+  int64_t *keyc = realloc(ct->keyc, cap * sizeof *keyc);
+  ct->keyc = keyc ? keyc : ct->keyc;
+  double *sc = realloc(ct->sc, cap * sizeof *sc);
+  ct->sc = sc ? sc : ct->sc;
+  double *mc = realloc(ct->mc, cap * sizeof *mc);
+  ct->mc = mc ? mc : ct->mc;
+  double *ac = realloc(ct->ac, cap * sizeof *ac);
+  ct->ac = ac ? ac : ct->ac;
+  if (!cand || !xc || !bc || !keyc || !sc || !mc || !ac)
+    return sph_error_set(err, SPH_ERR_NOMEM, "contact candidates");
   ct->cap = cap;
   return SPH_OK;
 }

@@ -19,8 +19,7 @@
 # on 3 ranks) on 2 and 3 ranks with its frames (and resumed from a
 # checkpoint on 2), and the turned plate (oblique planes; to 0.0025 s, before
 # its energy growth trips the verdict, its zig-zag not judged: R 0.52 by
-# 0.002 s serially) on 2, give the serial files too. Pairs of bodies with a
-# total-Lagrangian method stay refused.
+# 0.002 s serially) on 2, give the serial files too.
 # Usage: run_mpi_symmetry.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -92,8 +91,4 @@ rm -f "$work/ckr/${slot}_p1.sphc" "$work/ckr/summary.json" \
 [ -f "$work/ckr/punch_ul_csph_0008.pvtp" ] || fail "punch np 2 resumed: no last frame"
 resumed_like "punch np 2 resumed from its older checkpoint" "$work/ck" "$work/ckr"
 
-# refusals: exit 2 on every rank, the folder never made
-expect="contact between bodies does not run over MPI ranks with tl-csph"
-check "tl-csph pairs of bodies refused" refused run rubber_rings_ul_csph \
-  --quiet --set 'method={name: tl-csph}'
 summary

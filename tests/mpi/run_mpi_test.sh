@@ -4,8 +4,8 @@
 # files (check_mpi.py: fields, frames and probes identical, energies to 1e-12
 # relative, the .pvtp series read by VTK with the serial particles and
 # arrays); the same rank count twice writes the same bytes; --overwrite
-# removes a 4-rank run's pieces; what does not run over ranks yet is
-# refused with exit 2 before anything is written. Usage:
+# removes a 4-rank run's pieces; more ranks than useful and other commands
+# than run are refused with exit 2 before anything is written. Usage:
 # run_mpi_test.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -37,9 +37,6 @@ no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
 check "no stale pieces" no_stale
 
 # refusals: exit 2 on every rank, the folder never made
-expect="contact between bodies does not run over MPI ranks with tl-csph"
-check "tl-csph pairs of bodies refused" refused run rubber_rings_ul_csph \
-  --quiet --set 'method={name: tl-csph}'
 expect="more than useful"
 np=4 check "too many ranks refused" refused run twisting_column --quiet \
   --set 'method={name: tl-csph}' --set 'bodies.0.particles.count=[3,7,3]'

@@ -9,8 +9,7 @@
 # come from their owners, so every pair sum runs in the serial order. The
 # 2D path runs the punch with rollers on its symmetry planes (its mirror
 # images over ranks: run_mpi_symmetry.sh); the same rank count twice writes
-# the same bytes; pairs of bodies with tl-csph are refused (the contact term
-# of the rings: run_mpi_contact.sh).
+# the same bytes (the contact term of the rings: run_mpi_contact.sh).
 # Usage: run_mpi_ul_csph.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -38,9 +37,4 @@ migrates() { grep -Eq ' [1-9][0-9]* particles migrated' "$work/bar.log"; }
 check "bar np 4 migrates" migrates
 check "bar np 4 twice: identical files" same_bytes "$work/bar.np4" \
   "$work/bar.np4b"
-
-# refusals: exit 2 on every rank, the folder never made
-expect="contact between bodies does not run over MPI ranks with tl-csph"
-check "tl-csph pairs of bodies refused" refused run rubber_rings_ul_csph \
-  --quiet --set 'method={name: tl-csph}'
 summary
