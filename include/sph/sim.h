@@ -142,8 +142,9 @@ const sph_method_ops *sph_method_find(const char *name);
 const sph_method_ops *const *sph_method_list(void);
 
 /* Whether a run of scene s over MPI ranks needs rank 0 to hold a whole
- * view of the particles (gathered at each frame): the PNG frames and a
- * reference read one; the verdict, momenta, probes and counts do not. */
+ * view of the particles (gathered at each frame): a reference reads one;
+ * the PNG frames (drawn per rank and composited), the verdict, momenta,
+ * probes and counts do not. */
 int sph_sim_needs_whole_view(const sph_scene *s);
 
 /* Builds particles, looks up and sets up the method (its option errors point

@@ -211,7 +211,7 @@ static sph_status check_distributed_terms(const sph_sim *sim, sph_error *err) {
 }
 
 int sph_sim_needs_whole_view(const sph_scene *s) {
-  return s->output.png.enabled || s->reference;
+  return s->reference != NULL; /* frames are drawn per rank (sph/composite.h) */
 }
 
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
