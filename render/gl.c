@@ -527,6 +527,45 @@ static sph_status tag_setup(sph_gl *gl, sph_error *err) {
   return SPH_OK;
 }
 
+/* Instances a tagged draw hands llvmpipe at once: its binned triangles
+ * (about 600 bytes an instance) then stay bounded however many a rank
+ * draws. */
+#define SPH_GL_CHUNK 4096
+
+/* Draws layer l's instances in order, SPH_GL_CHUNK at a time (the
+ * attribute pointers moved along the buffers; GL 3.3 has no base
+ * instance), each chunk flushed: the same fragments in the same order. */
+static void draw_chunks(sph_gl *gl, const sph_gl_layer *l) {
+  for (size_t first = 0; first < l->n; first += SPH_GL_CHUNK) {
+    size_t count = l->n - first < SPH_GL_CHUNK ? l->n - first : SPH_GL_CHUNK;
+    glBindBuffer(GL_ARRAY_BUFFER, gl->centre_vbo);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0,
+                          (const void *)(first * 3 * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
+    glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_TRUE, 0,
+                          (const void *)(first * 3));
+    glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+    glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0,
+                          (const void *)(first * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+    glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, 0,
+                           (const void *)(first * sizeof(uint32_t)));
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)count);
+    glFlush();
+  }
+  /* the pointers back at the buffers' starts */
+  glBindBuffer(GL_ARRAY_BUFFER, gl->centre_vbo);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
+  glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_TRUE, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+  glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+  glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
 /* Checks the arguments and draws the layers (tagged: into the colour and
  * tag attachments, each layer's keys with its instances). */
 static sph_status draw_pass(sph_gl *gl, const sph_view *view,
@@ -600,7 +639,10 @@ static sph_status draw_pass(sph_gl *gl, const sph_view *view,
     set_uniforms(gl, pr, view, l->radius, l->clip_plane, l->flat);
     if (tagged)
       glUniform1ui(pr->layer, (GLuint)(i + 1));
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)l->n);
+    if (tagged)
+      draw_chunks(gl, l);
+    else
+      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)l->n);
     if (tagged)
       glDisableVertexAttribArray(4);
     glBindVertexArray(0);
