@@ -144,7 +144,7 @@ struct sph_gl {
   GLuint fbo, colour_rb, depth_rb, tag_fbo, tag_rb;
   size_t capacity;         /* instances the centre/colour buffers hold */
   unsigned char *readback; /* width * height * 4, bottom row first */
-  uint32_t *tags;          /* tagged frames: width * height * 4 */
+  sph_composite_px *px;    /* tagged frames: width * height, then 2 rows */
 };
 
 /* Makes the context current on this thread. */
@@ -489,9 +489,9 @@ static sph_status check_layer(const sph_gl_layer *l, sph_error *err) {
 static sph_status tag_setup(sph_gl *gl, sph_error *err) {
   if (gl->tag.id)
     return SPH_OK;
-  size_t npix = (size_t)gl->width * (size_t)gl->height;
-  gl->tags = malloc(4 * npix * sizeof *gl->tags);
-  if (!gl->tags)
+  size_t npix = (size_t)gl->width * (size_t)(gl->height + 2);
+  gl->px = malloc(npix * sizeof *gl->px);
+  if (!gl->px)
     return sph_error_set(err, SPH_ERR_NOMEM, "render: out of memory");
   SPH_TRY(build_program(&gl->tag, 1, err));
   /* keys: 1 unsigned integer per instance */
@@ -671,33 +671,46 @@ sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
   return SPH_OK;
 }
 
+/* Output row y of the tagged frame from GL row g (bottom-up), its tags
+ * read from tag and colours from gl->readback. */
+static void tag_row(sph_gl *gl, int y, int g, const sph_composite_px *tag) {
+  size_t w = (size_t)gl->width;
+  const unsigned char *c = gl->readback + (size_t)g * w * 4;
+  sph_composite_px *o = gl->px + (size_t)y * w;
+  for (size_t x = 0; x < w; ++x) {
+    o[x] = tag[x];
+    o[x].depth &= 0x7fffffffu; /* -0 as +0, as GL compares */
+    memcpy(&o[x].rgba, c + 4 * x, 4);
+  }
+}
+
 sph_status sph_gl_draw_tagged(sph_gl *gl, const sph_view *view,
                               const sph_gl_layer *layers, int nlayers,
-                              sph_composite_px *px, sph_error *err) {
+                              const sph_composite_px **px, sph_error *err) {
   if (!px)
     return sph_error_set(err, SPH_ERR_ARG, "render: missing pixels");
   SPH_TRY(draw_pass(gl, view, layers, nlayers, 1, err));
-  /* colours and tags back (bottom row first), top row first into px */
+  /* colours and tags back, bottom row first (a tag is 4 unsigned ints:
+   * layer, depth bits, key, 0, as sph_composite_px) */
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, gl->width, gl->height, GL_RGBA, GL_UNSIGNED_BYTE,
                gl->readback);
   glReadBuffer(GL_COLOR_ATTACHMENT1);
   glReadPixels(0, 0, gl->width, gl->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
-               gl->tags);
+               gl->px);
   SPH_TRY(gl_check("tagged draw", err));
+  /* in place, top row first: rows y and its mirror through two spare rows */
   size_t w = (size_t)gl->width;
-  for (int y = 0; y < gl->height; ++y) {
-    const uint32_t *t = gl->tags + (size_t)(gl->height - 1 - y) * w * 4;
-    const unsigned char *c =
-        gl->readback + (size_t)(gl->height - 1 - y) * w * 4;
-    sph_composite_px *o = px + (size_t)y * w;
-    for (size_t x = 0; x < w; ++x) {
-      o[x].layer = t[4 * x];
-      o[x].depth = t[4 * x + 1] & 0x7fffffffu; /* -0 as +0, as GL compares */
-      o[x].key = t[4 * x + 2];
-      memcpy(&o[x].rgba, c + 4 * x, 4);
-    }
+  sph_composite_px *spare = gl->px + (size_t)gl->height * w;
+  for (int y = 0; y <= (gl->height - 1) / 2; ++y) {
+    int g = gl->height - 1 - y;
+    memcpy(spare, gl->px + (size_t)y * w, w * sizeof *spare);
+    memcpy(spare + w, gl->px + (size_t)g * w, w * sizeof *spare);
+    tag_row(gl, y, g, spare + w);
+    if (g != y)
+      tag_row(gl, g, y, spare);
   }
+  *px = gl->px;
   return SPH_OK;
 }
 
@@ -732,6 +745,6 @@ void sph_gl_destroy(sph_gl *gl) {
   if (gl->ctx)
     OSMesaDestroyContext(gl->ctx);
   free(gl->readback);
-  free(gl->tags);
+  free(gl->px);
   free(gl);
 }

@@ -127,13 +127,14 @@ sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
                               sph_image *img, sph_error *err);
 
 /* sph_gl_draw_layers for a frame composited over ranks (sph/composite.h):
- * into px (width * height, top row first) the colour, layer (i + 1, 0 for
- * the background), window depth bits and key of the fragment that won each
+ * *px points to the context's width * height pixels (top row first, valid
+ * until the next draw) holding the colour, layer (i + 1, 0 for the
+ * background), window depth bits and key of the fragment that won each
  * pixel, the layers' spheres drawn in the order given (ascending keys give
  * the serial winner at a depth tie). Every layer with spheres needs keys. */
 sph_status sph_gl_draw_tagged(sph_gl *gl, const sph_view *view,
                               const sph_gl_layer *layers, int nlayers,
-                              sph_composite_px *px, sph_error *err);
+                              const sph_composite_px **px, sph_error *err);
 
 /* Releases the context and its buffers. Accepts NULL. */
 void sph_gl_destroy(sph_gl *gl);

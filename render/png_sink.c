@@ -109,12 +109,12 @@ typedef struct png_sink {
    * images are composited onto rank 0, which writes the frame */
   sph_domain *domain; /* NULL: a serial run */
   int rank;
-  size_t cap;                 /* particles a rank may hold */
-  double *cut_c;              /* cut: per body sums of X (3) and count */
-  int cut_axis;               /* cut: the axis closest to the view */
-  double cut_sign;            /* cut: its direction */
-  int64_t *order;             /* (id, index) of each owned particle */
-  sph_composite_px *px, *cpx; /* this rank's image; rank 0: the composite */
+  size_t cap;            /* particles a rank may hold */
+  double *cut_c;         /* cut: per body sums of X (3) and count */
+  int cut_axis;          /* cut: the axis closest to the view */
+  double cut_sign;       /* cut: its direction */
+  int64_t *order;        /* (id, index) of each owned particle */
+  sph_composite_px *cpx; /* rank 0: the composite */
   pthread_t thread;
   pthread_mutex_t mu;
   pthread_cond_t cv;
@@ -529,12 +529,13 @@ static sph_status png_render_ranks(png_sink *p, const png_frame *fr,
   sph_gl_layer layers[3];
   png_layers(p, fr, layers);
   sph_error gerr;
-  sph_status st = sph_gl_draw_tagged(p->gl, &fr->view, layers, 3, p->px, &gerr);
+  const sph_composite_px *px = NULL;
+  sph_status st = sph_gl_draw_tagged(p->gl, &fr->view, layers, 3, &px, &gerr);
   if (st != SPH_OK)
     sph_error_at(err, st, path, 0, 0, NULL, "%s", gerr.message);
   SPH_TRY(sph_domain_agree(p->domain, st, err));
   size_t npix = (size_t)p->width * (size_t)p->height;
-  SPH_TRY(sph_composite_reduce(p->domain, p->px, npix, p->cpx, err));
+  SPH_TRY(sph_composite_reduce(p->domain, px, npix, p->cpx, err));
   if (p->rank != 0)
     return SPH_OK;
   for (size_t i = 0; i < npix; ++i)
@@ -706,10 +707,9 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
     SPH_TRY(sph_image_create(&p->img, o->width, o->height, err));
   if (p->domain) {
     size_t npix = (size_t)o->width * (size_t)o->height;
-    p->px = malloc(npix * sizeof *p->px);
     p->cpx = p->rank == 0 ? malloc(npix * sizeof *p->cpx) : NULL;
     p->order = malloc(2 * n * sizeof *p->order);
-    if (!p->px || (p->rank == 0 && !p->cpx) || !p->order)
+    if ((p->rank == 0 && !p->cpx) || !p->order)
       return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   }
   /* field, range policy and map */
@@ -1204,7 +1204,6 @@ static void png_destroy(sph_sink *sink) {
   free(p->work);
   free(p->cut_c);
   free(p->order);
-  free(p->px);
   free(p->cpx);
   for (int i = 0; i < 2; ++i) {
     free(p->slot[i].key);
