@@ -265,6 +265,16 @@ static void build_vertex_array(sph_gl *gl) {
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
+/* Whether the bound framebuffer is complete. */
+static sph_status complete(const char *which, sph_error *err) {
+  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
+                         "OpenGL: %s framebuffer incomplete (0x%04x)", which,
+                         (unsigned)status);
+  return SPH_OK;
+}
+
 /* Off-screen framebuffer: RGBA8 colour and 32-bit float depth. */
 static sph_status build_framebuffer(sph_gl *gl, sph_error *err) {
   glGenRenderbuffers(1, &gl->colour_rb);
@@ -281,12 +291,7 @@ static sph_status build_framebuffer(sph_gl *gl, sph_error *err) {
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
                             GL_RENDERBUFFER, gl->depth_rb);
   SPH_TRY(gl_check("framebuffer storage", err));
-  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-  if (status != GL_FRAMEBUFFER_COMPLETE)
-    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
-                         "OpenGL: off-screen framebuffer incomplete (0x%04x)",
-                         (unsigned)status);
-  return SPH_OK;
+  return complete("off-screen", err);
 }
 
 sph_status sph_gl_create(int width, int height, sph_gl **out, sph_error *err) {
@@ -519,12 +524,7 @@ static sph_status tag_setup(sph_gl *gl, sph_error *err) {
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
                             GL_RENDERBUFFER, gl->depth_rb);
   SPH_TRY(gl_check("tag framebuffer", err));
-  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-  if (status != GL_FRAMEBUFFER_COMPLETE)
-    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
-                         "OpenGL: tagged framebuffer incomplete (0x%04x)",
-                         (unsigned)status);
-  return SPH_OK;
+  return complete("tagged", err);
 }
 
 /* Instances a tagged draw hands llvmpipe at once: its binned triangles

@@ -1051,6 +1051,18 @@ static void png_take(const png_sink *p, const sph_particles *ps, size_t a,
   s->value[m] = v;
 }
 
+/* A finite colour value v into the frame's least, greatest, largest
+ * distance from the centre c0 and the values p->work (nf of them). */
+static void png_count(png_sink *p, double v, double c0, double *vmin,
+                      double *vmax, double *amax, size_t *nf) {
+  if (!isfinite(v))
+    return;
+  *vmin = fmin(*vmin, v);
+  *vmax = fmax(*vmax, v);
+  *amax = fmax(*amax, fabs(v - c0));
+  p->work[(*nf)++] = v;
+}
+
 /* A non-finite position fails here, as the sphere pass would, so the
  * frame is not written. */
 static sph_status png_finite(const png_frame *s, size_t m, sph_error *err) {
@@ -1074,12 +1086,7 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
   for (size_t j = 0; j < n; ++j) { /* creation order, as the VTK files */
     size_t a = sph_particles_slot(fr->ps, j);
     double v = field ? sph_png_value(field, nc, a) : NAN;
-    if (isfinite(v)) {
-      vmin = fmin(vmin, v);
-      vmax = fmax(vmax, v);
-      amax = fmax(amax, fabs(v - c0));
-      p->work[nf++] = v;
-    }
+    png_count(p, v, c0, &vmin, &vmax, &amax, &nf);
     if (!p->keep[a])
       continue;
     png_take(p, fr->ps, a, v, s, m++);
@@ -1124,12 +1131,7 @@ static sph_status png_snapshot_ranks(png_sink *p, const sph_frame *fr,
   for (size_t i = 0; i < n; ++i) {
     size_t a = (size_t)p->order[2 * i + 1];
     double v = field ? sph_png_value(field, nc, a) : NAN;
-    if (isfinite(v)) {
-      vmin = fmin(vmin, v);
-      vmax = fmax(vmax, v);
-      amax = fmax(amax, fabs(v - c0));
-      p->work[nf++] = v;
-    }
+    png_count(p, v, c0, &vmin, &vmax, &amax, &nf);
     if (!cut_keeps(p->cut_c, p->cut_axis, p->cut_sign, p->dp, X, ps->body, a))
       continue;
     s->key[m] = (uint32_t)ps->id[a];
