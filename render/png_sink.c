@@ -677,9 +677,9 @@ static void png_stop(png_sink *p) {
   p->started = 0;
 }
 
-/* Allocates and fills everything but the renderer. */
-static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
-                            sph_error *err) {
+/* The frames folder, the buffers a rank needs and the colour policy. */
+static sph_status png_setup_buffers(png_sink *p, const sph_sim *sim,
+                                    const char *dir, sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_png_output *o = &s->output.png;
   snprintf(p->dir, sizeof p->dir, "%s/frames", dir);
@@ -750,6 +750,18 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   snprintf(p->title, sizeof p->title, "%s%s%s%s%s", sph_field_name(f),
            p->ncomp > 1 ? " magnitude" : "", unit && *unit ? " [" : "",
            unit ? unit : "", unit && *unit ? "]" : "");
+  return SPH_OK;
+}
+
+/* Allocates and fills everything but the renderer; over MPI ranks every
+ * rank fails when one does before the reductions (collective). */
+static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
+                            sph_error *err) {
+  sph_status st = png_setup_buffers(p, sim, dir, err);
+  SPH_TRY(sph_domain_agree(sim->domain, st, err));
+  const sph_scene *s = sim->scene;
+  const sph_png_output *o = &s->output.png;
+  size_t n = p->cap ? p->cap : 1;
   /* camera, cutaways and the reference outline */
   png_view(sim, &p->view, p->fit_lo, p->fit_hi);
   SPH_TRY(sph_view_check(&p->view, err));
@@ -831,7 +843,8 @@ static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
   sink->thread_seconds = 0.0;
   p->threaded = threaded && !sim->domain; /* collectives: one thread */
   threaded = p->threaded;
-  SPH_TRY(png_setup(p, sim, dir, err));
+  sph_status st = png_setup(p, sim, dir, err);
+  SPH_TRY(sph_domain_agree(sim->domain, st, err)); /* before the replay's */
   png_replay(p, sim, dir, sink->resume_frames);
   if (!threaded)
     return png_renderer_create(p, err);
