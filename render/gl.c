@@ -21,7 +21,6 @@
  * half size of the tangent cone's circle in the plane of the centre, so the
  * silhouette is inscribed exactly; ortho quads are 2r x 2r squares. */
 static const char *const vertex_src =
-    "#version 330 core\n"
     "layout(location = 0) in vec2 corner;\n"
     "layout(location = 1) in vec3 centre;\n"
     "layout(location = 2) in vec3 colour;\n"
@@ -38,7 +37,14 @@ static const char *const vertex_src =
     "out vec3 v_pos;\n"
     "out vec2 v_quad;\n"
     "out float gl_ClipDistance[1];\n"
+    "#ifdef TAGGED\n"
+    "layout(location = 4) in uint key;\n"
+    "flat out uint v_key;\n"
+    "#endif\n"
     "void main() {\n"
+    "#ifdef TAGGED\n"
+    "  v_key = key;\n"
+    "#endif\n"
     "  vec3 c = (view * vec4(centre, 1.0)).xyz;\n"
     "  float r = radius * scale;\n"
     "  v_radius = r;\n"
@@ -71,7 +77,6 @@ static const char *const vertex_src =
  * disc point lifted onto the hemisphere), its window depth, and ambient +
  * Lambert + Blinn-Phong shading under a light fixed to the camera. */
 static const char *const fragment_src =
-    "#version 330 core\n"
     "in vec3 v_colour;\n"
     "flat in vec3 v_centre;\n"
     "flat in float v_radius;\n"
@@ -81,6 +86,11 @@ static const char *const fragment_src =
     "uniform int ortho;\n"
     "uniform int flat_colour;\n"
     "out vec4 frag;\n"
+    "#ifdef TAGGED\n"
+    "flat in uint v_key;\n"
+    "uniform uint layer;\n"
+    "out uvec4 tag;\n"
+    "#endif\n"
     "void main() {\n"
     "  vec3 light = normalize(vec3(-0.3, 0.4, 1.0));\n"
     "  vec3 n, p, to_eye;\n"
@@ -104,6 +114,9 @@ static const char *const fragment_src =
     "  float depth = 0.5 * clip.z / clip.w + 0.5;\n"
     "  if (depth < 0.0 || depth > 1.0) discard;\n"
     "  gl_FragDepth = depth;\n"
+    "#ifdef TAGGED\n"
+    "  tag = uvec4(layer, floatBitsToUint(depth), v_key, 0u);\n"
+    "#endif\n"
     "  if (flat_colour != 0) {\n"
     "    frag = vec4(v_colour, 1.0);\n"
     "    return;\n"
@@ -115,16 +128,23 @@ static const char *const fragment_src =
     "  frag = vec4(min(rgb, vec3(1.0)), 1.0);\n"
     "}\n";
 
+/* A sphere program and its uniforms. */
+typedef struct gl_program {
+  GLuint id;
+  GLint view, proj, radius, ortho, use_clip, plane, flat, layer;
+} gl_program;
+
 struct sph_gl {
   OSMesaContext ctx;
   unsigned char front[4]; /* 1x1 window buffer OSMesa needs; unused */
   int width, height;
-  GLuint program, vao, quad_vbo, centre_vbo, colour_vbo, scale_vbo;
-  GLuint fbo, colour_rb, depth_rb;
-  GLint loc_view, loc_proj, loc_radius, loc_ortho, loc_use_clip, loc_plane;
-  GLint loc_flat;
+  gl_program prog; /* the frame's colours */
+  gl_program tag;  /* the same with the tag output (made on first use) */
+  GLuint vao, quad_vbo, centre_vbo, colour_vbo, scale_vbo, key_vbo;
+  GLuint fbo, colour_rb, depth_rb, tag_fbo, tag_rb;
   size_t capacity;         /* instances the centre/colour buffers hold */
   unsigned char *readback; /* width * height * 4, bottom row first */
+  sph_composite_px *px;    /* tagged frames: width * height, then 2 rows */
 };
 
 /* Makes the context current on this thread. */
@@ -149,12 +169,15 @@ static sph_status gl_check(const char *what, sph_error *err) {
                        (unsigned)first, what);
 }
 
-/* Compiles one shader stage; the info log goes into the error on failure. */
-static sph_status compile(GLenum type, const char *src, GLuint *out,
+/* Compiles one shader stage (tagged: with TAGGED defined); the info log
+ * goes into the error on failure. */
+static sph_status compile(GLenum type, const char *src, int tagged, GLuint *out,
                           sph_error *err) {
   GLuint sh = glCreateShader(type);
   GLint ok = 0;
-  glShaderSource(sh, 1, &src, NULL);
+  const char *parts[3] = {"#version 330 core\n",
+                          tagged ? "#define TAGGED 1\n" : "", src};
+  glShaderSource(sh, 3, parts, NULL);
   glCompileShader(sh);
   glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
   if (!ok) {
@@ -169,39 +192,45 @@ static sph_status compile(GLenum type, const char *src, GLuint *out,
   return SPH_OK;
 }
 
-/* Builds the sphere program and looks up its uniforms. */
-static sph_status build_program(sph_gl *gl, sph_error *err) {
+/* Builds the sphere program (tagged: with the tag output on draw buffer
+ * 1) and looks up its uniforms. */
+static sph_status build_program(gl_program *pr, int tagged, sph_error *err) {
   GLuint vs = 0, fs = 0;
   GLint ok = 0;
-  SPH_TRY(compile(GL_VERTEX_SHADER, vertex_src, &vs, err));
-  sph_status st = compile(GL_FRAGMENT_SHADER, fragment_src, &fs, err);
+  SPH_TRY(compile(GL_VERTEX_SHADER, vertex_src, tagged, &vs, err));
+  sph_status st = compile(GL_FRAGMENT_SHADER, fragment_src, tagged, &fs, err);
   if (st != SPH_OK) {
     glDeleteShader(vs);
     return st;
   }
   /* link, then the shader objects are no longer needed */
-  gl->program = glCreateProgram();
-  glAttachShader(gl->program, vs);
-  glAttachShader(gl->program, fs);
-  glLinkProgram(gl->program);
-  glDetachShader(gl->program, vs);
-  glDetachShader(gl->program, fs);
+  pr->id = glCreateProgram();
+  glAttachShader(pr->id, vs);
+  glAttachShader(pr->id, fs);
+  if (tagged) {
+    glBindFragDataLocation(pr->id, 0, "frag");
+    glBindFragDataLocation(pr->id, 1, "tag");
+  }
+  glLinkProgram(pr->id);
+  glDetachShader(pr->id, vs);
+  glDetachShader(pr->id, fs);
   glDeleteShader(vs);
   glDeleteShader(fs);
-  glGetProgramiv(gl->program, GL_LINK_STATUS, &ok);
+  glGetProgramiv(pr->id, GL_LINK_STATUS, &ok);
   if (!ok) {
     char log[512] = "";
-    glGetProgramInfoLog(gl->program, sizeof log, NULL, log);
+    glGetProgramInfoLog(pr->id, sizeof log, NULL, log);
     return sph_error_set(err, SPH_ERR_UNSUPPORTED,
                          "OpenGL: sphere program does not link: %s", log);
   }
-  gl->loc_view = glGetUniformLocation(gl->program, "view");
-  gl->loc_proj = glGetUniformLocation(gl->program, "proj");
-  gl->loc_radius = glGetUniformLocation(gl->program, "radius");
-  gl->loc_ortho = glGetUniformLocation(gl->program, "ortho");
-  gl->loc_use_clip = glGetUniformLocation(gl->program, "use_clip");
-  gl->loc_plane = glGetUniformLocation(gl->program, "clip_plane");
-  gl->loc_flat = glGetUniformLocation(gl->program, "flat_colour");
+  pr->view = glGetUniformLocation(pr->id, "view");
+  pr->proj = glGetUniformLocation(pr->id, "proj");
+  pr->radius = glGetUniformLocation(pr->id, "radius");
+  pr->ortho = glGetUniformLocation(pr->id, "ortho");
+  pr->use_clip = glGetUniformLocation(pr->id, "use_clip");
+  pr->plane = glGetUniformLocation(pr->id, "clip_plane");
+  pr->flat = glGetUniformLocation(pr->id, "flat_colour");
+  pr->layer = glGetUniformLocation(pr->id, "layer");
   return SPH_OK;
 }
 
@@ -236,6 +265,16 @@ static void build_vertex_array(sph_gl *gl) {
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
+/* Whether the bound framebuffer is complete. */
+static sph_status complete(const char *which, sph_error *err) {
+  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
+                         "OpenGL: %s framebuffer incomplete (0x%04x)", which,
+                         (unsigned)status);
+  return SPH_OK;
+}
+
 /* Off-screen framebuffer: RGBA8 colour and 32-bit float depth. */
 static sph_status build_framebuffer(sph_gl *gl, sph_error *err) {
   glGenRenderbuffers(1, &gl->colour_rb);
@@ -252,12 +291,7 @@ static sph_status build_framebuffer(sph_gl *gl, sph_error *err) {
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
                             GL_RENDERBUFFER, gl->depth_rb);
   SPH_TRY(gl_check("framebuffer storage", err));
-  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-  if (status != GL_FRAMEBUFFER_COMPLETE)
-    return sph_error_set(err, SPH_ERR_UNSUPPORTED,
-                         "OpenGL: off-screen framebuffer incomplete (0x%04x)",
-                         (unsigned)status);
-  return SPH_OK;
+  return complete("off-screen", err);
 }
 
 sph_status sph_gl_create(int width, int height, sph_gl **out, sph_error *err) {
@@ -327,7 +361,7 @@ sph_status sph_gl_create(int width, int height, sph_gl **out, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NOMEM, "render: out of memory");
   }
   /* program, vertex arrays, framebuffer */
-  st = build_program(gl, err);
+  st = build_program(&gl->prog, 0, err);
   if (st == SPH_OK) {
     build_vertex_array(gl);
     st = build_framebuffer(gl, err);
@@ -362,6 +396,11 @@ static sph_status reserve(sph_gl *gl, size_t n, sph_error *err) {
   glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
   glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(cap * sizeof(float)), NULL,
                GL_DYNAMIC_DRAW);
+  if (gl->key_vbo) {
+    glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(cap * sizeof(uint32_t)), NULL,
+                 GL_DYNAMIC_DRAW);
+  }
   glBindBuffer(GL_ARRAY_BUFFER, 0);
   SPH_TRY(gl_check("instance buffers", err));
   gl->capacity = cap;
@@ -398,7 +437,8 @@ static void set_state(sph_gl *gl) {
 }
 
 /* Uploads the camera, radius, clip plane and shading uniforms. */
-static void set_uniforms(sph_gl *gl, const sph_view *view, float radius,
+static void set_uniforms(sph_gl *gl, const gl_program *prog,
+                         const sph_view *view, float radius,
                          const double *clip_plane, int flat) {
   double mv[16], pr[16];
   float mvf[16], prf[16];
@@ -408,18 +448,18 @@ static void set_uniforms(sph_gl *gl, const sph_view *view, float radius,
     mvf[k] = (float)mv[k];
     prf[k] = (float)pr[k];
   }
-  glUseProgram(gl->program);
-  glUniformMatrix4fv(gl->loc_view, 1, GL_FALSE, mvf);
-  glUniformMatrix4fv(gl->loc_proj, 1, GL_FALSE, prf);
-  glUniform1f(gl->loc_radius, radius);
-  glUniform1i(gl->loc_ortho, view->ortho ? 1 : 0);
-  glUniform1i(gl->loc_use_clip, clip_plane ? 1 : 0);
-  glUniform1i(gl->loc_flat, flat ? 1 : 0);
+  glUseProgram(prog->id);
+  glUniformMatrix4fv(prog->view, 1, GL_FALSE, mvf);
+  glUniformMatrix4fv(prog->proj, 1, GL_FALSE, prf);
+  glUniform1f(prog->radius, radius);
+  glUniform1i(prog->ortho, view->ortho ? 1 : 0);
+  glUniform1i(prog->use_clip, clip_plane ? 1 : 0);
+  glUniform1i(prog->flat, flat ? 1 : 0);
   if (clip_plane)
-    glUniform4f(gl->loc_plane, (float)clip_plane[0], (float)clip_plane[1],
+    glUniform4f(prog->plane, (float)clip_plane[0], (float)clip_plane[1],
                 (float)clip_plane[2], (float)clip_plane[3]);
   else
-    glUniform4f(gl->loc_plane, 0.f, 0.f, 0.f, 1.f);
+    glUniform4f(prog->plane, 0.f, 0.f, 0.f, 1.f);
 }
 
 /* Checks one layer's arguments. */
@@ -449,30 +489,124 @@ static sph_status check_layer(const sph_gl_layer *l, sph_error *err) {
   return SPH_OK;
 }
 
-sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
-                              const sph_gl_layer *layers, int nlayers,
-                              sph_image *img, sph_error *err) {
+/* The tagged program, its key buffer, the tag attachment and its
+ * framebuffer (colour and depth shared with the plain one), made once. */
+static sph_status tag_setup(sph_gl *gl, sph_error *err) {
+  if (gl->tag.id)
+    return SPH_OK;
+  size_t npix = (size_t)gl->width * (size_t)(gl->height + 2);
+  gl->px = malloc(npix * sizeof *gl->px);
+  if (!gl->px)
+    return sph_error_set(err, SPH_ERR_NOMEM, "render: out of memory");
+  SPH_TRY(build_program(&gl->tag, 1, err));
+  /* keys: 1 unsigned integer per instance */
+  glGenBuffers(1, &gl->key_vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+  glBufferData(
+      GL_ARRAY_BUFFER,
+      (GLsizeiptr)((gl->capacity ? gl->capacity : 1) * sizeof(uint32_t)), NULL,
+      GL_DYNAMIC_DRAW);
+  glBindVertexArray(gl->vao);
+  glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, 0, NULL);
+  glVertexAttribDivisor(4, 1);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  /* the tag attachment */
+  glGenRenderbuffers(1, &gl->tag_rb);
+  glBindRenderbuffer(GL_RENDERBUFFER, gl->tag_rb);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32UI, gl->width, gl->height);
+  glGenFramebuffers(1, &gl->tag_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl->tag_fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                            GL_RENDERBUFFER, gl->colour_rb);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1,
+                            GL_RENDERBUFFER, gl->tag_rb);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
+                            GL_RENDERBUFFER, gl->depth_rb);
+  SPH_TRY(gl_check("tag framebuffer", err));
+  return complete("tagged", err);
+}
+
+/* Instances a tagged draw hands llvmpipe at once: its binned triangles
+ * (about 600 bytes an instance) then stay bounded however many a rank
+ * draws. */
+#define SPH_GL_CHUNK 4096
+
+/* Draws layer l's instances in order, SPH_GL_CHUNK at a time (the
+ * attribute pointers moved along the buffers; GL 3.3 has no base
+ * instance), each chunk flushed: the same fragments in the same order. */
+static void draw_chunks(sph_gl *gl, const sph_gl_layer *l) {
+  for (size_t first = 0; first < l->n; first += SPH_GL_CHUNK) {
+    size_t count = l->n - first < SPH_GL_CHUNK ? l->n - first : SPH_GL_CHUNK;
+    glBindBuffer(GL_ARRAY_BUFFER, gl->centre_vbo);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0,
+                          (const void *)(first * 3 * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
+    glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_TRUE, 0,
+                          (const void *)(first * 3));
+    glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+    glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0,
+                          (const void *)(first * sizeof(float)));
+    glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+    glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, 0,
+                           (const void *)(first * sizeof(uint32_t)));
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)count);
+    glFlush();
+  }
+  /* the pointers back at the buffers' starts */
+  glBindBuffer(GL_ARRAY_BUFFER, gl->centre_vbo);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->colour_vbo);
+  glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_TRUE, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->scale_vbo);
+  glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+  glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, 0, NULL);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+/* Checks the arguments and draws the layers (tagged: into the colour and
+ * tag attachments, each layer's keys with its instances). */
+static sph_status draw_pass(sph_gl *gl, const sph_view *view,
+                            const sph_gl_layer *layers, int nlayers, int tagged,
+                            sph_error *err) {
   /* arguments */
-  if (!gl || !img || (nlayers > 0 && !layers))
+  if (!gl || (nlayers > 0 && !layers))
     return sph_error_set(err, SPH_ERR_ARG, "render: missing context or image");
-  if (img->width != gl->width || img->height != gl->height || !img->rgba)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "render: image is %d x %d, the context draws %d x %d",
-                         img->width, img->height, gl->width, gl->height);
   size_t most = 0;
   for (int i = 0; i < nlayers; ++i) {
     SPH_TRY(check_layer(&layers[i], err));
+    if (tagged && layers[i].n > 0 && !layers[i].key)
+      return sph_error_set(err, SPH_ERR_ARG, "render: missing keys");
     most = layers[i].n > most ? layers[i].n : most;
   }
   SPH_TRY(sph_view_check(view, err));
   SPH_TRY(make_current(gl, err));
+  if (tagged)
+    SPH_TRY(tag_setup(gl, err));
   SPH_TRY(reserve(gl, most, err));
   /* state, background */
   set_state(gl);
-  glClearColor(SPH_GL_BACKGROUND / 255.0f, SPH_GL_BACKGROUND / 255.0f,
-               SPH_GL_BACKGROUND / 255.0f, 1.0f);
-  glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  const gl_program *pr = tagged ? &gl->tag : &gl->prog;
+  if (tagged) {
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    static const GLuint none[4] = {0, 0, 0, 0};
+    const GLfloat bg[4] = {SPH_GL_BACKGROUND / 255.0f,
+                           SPH_GL_BACKGROUND / 255.0f,
+                           SPH_GL_BACKGROUND / 255.0f, 1.0f};
+    glBindFramebuffer(GL_FRAMEBUFFER, gl->tag_fbo);
+    glDrawBuffers(2, bufs);
+    glClearBufferfv(GL_COLOR, 0, bg);
+    glClearBufferuiv(GL_COLOR, 1, none);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+  } else {
+    glClearColor(SPH_GL_BACKGROUND / 255.0f, SPH_GL_BACKGROUND / 255.0f,
+                 SPH_GL_BACKGROUND / 255.0f, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  }
   /* each layer's instances in index order, over the layers before it */
   for (int i = 0; i < nlayers; ++i) {
     const sph_gl_layer *l = &layers[i];
@@ -495,11 +629,37 @@ sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
       glDisableVertexAttribArray(3);
       glVertexAttrib1f(3, 1.0f);
     }
+    if (tagged) {
+      glBindBuffer(GL_ARRAY_BUFFER, gl->key_vbo);
+      glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(l->n * sizeof(uint32_t)),
+                      l->key);
+      glEnableVertexAttribArray(4);
+    }
     glBindBuffer(GL_ARRAY_BUFFER, 0);
-    set_uniforms(gl, view, l->radius, l->clip_plane, l->flat);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)l->n);
+    set_uniforms(gl, pr, view, l->radius, l->clip_plane, l->flat);
+    if (tagged)
+      glUniform1ui(pr->layer, (GLuint)(i + 1));
+    if (tagged)
+      draw_chunks(gl, l);
+    else
+      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)l->n);
+    if (tagged)
+      glDisableVertexAttribArray(4);
     glBindVertexArray(0);
   }
+  return SPH_OK;
+}
+
+sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
+                              const sph_gl_layer *layers, int nlayers,
+                              sph_image *img, sph_error *err) {
+  if (!gl || !img)
+    return sph_error_set(err, SPH_ERR_ARG, "render: missing context or image");
+  if (img->width != gl->width || img->height != gl->height || !img->rgba)
+    return sph_error_set(err, SPH_ERR_ARG,
+                         "render: image is %d x %d, the context draws %d x %d",
+                         img->width, img->height, gl->width, gl->height);
+  SPH_TRY(draw_pass(gl, view, layers, nlayers, 0, err));
   /* read back (GL rows run bottom-up) and flip into the image */
   glReadPixels(0, 0, gl->width, gl->height, GL_RGBA, GL_UNSIGNED_BYTE,
                gl->readback);
@@ -511,12 +671,55 @@ sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
   return SPH_OK;
 }
 
+/* Output row y of the tagged frame from GL row g (bottom-up), its tags
+ * read from tag and colours from gl->readback. */
+static void tag_row(sph_gl *gl, int y, int g, const sph_composite_px *tag) {
+  size_t w = (size_t)gl->width;
+  const unsigned char *c = gl->readback + (size_t)g * w * 4;
+  sph_composite_px *o = gl->px + (size_t)y * w;
+  for (size_t x = 0; x < w; ++x) {
+    o[x] = tag[x];
+    o[x].depth &= 0x7fffffffu; /* -0 as +0, as GL compares */
+    memcpy(&o[x].rgba, c + 4 * x, 4);
+  }
+}
+
+sph_status sph_gl_draw_tagged(sph_gl *gl, const sph_view *view,
+                              const sph_gl_layer *layers, int nlayers,
+                              const sph_composite_px **px, sph_error *err) {
+  if (!px)
+    return sph_error_set(err, SPH_ERR_ARG, "render: missing pixels");
+  SPH_TRY(draw_pass(gl, view, layers, nlayers, 1, err));
+  /* colours and tags back, bottom row first (a tag is 4 unsigned ints:
+   * layer, depth bits, key, 0, as sph_composite_px) */
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, gl->width, gl->height, GL_RGBA, GL_UNSIGNED_BYTE,
+               gl->readback);
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  glReadPixels(0, 0, gl->width, gl->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+               gl->px);
+  SPH_TRY(gl_check("tagged draw", err));
+  /* in place, top row first: rows y and its mirror through two spare rows */
+  size_t w = (size_t)gl->width;
+  sph_composite_px *spare = gl->px + (size_t)gl->height * w;
+  for (int y = 0; y <= (gl->height - 1) / 2; ++y) {
+    int g = gl->height - 1 - y;
+    memcpy(spare, gl->px + (size_t)y * w, w * sizeof *spare);
+    memcpy(spare + w, gl->px + (size_t)g * w, w * sizeof *spare);
+    tag_row(gl, y, g, spare + w);
+    if (g != y)
+      tag_row(gl, g, y, spare);
+  }
+  *px = gl->px;
+  return SPH_OK;
+}
+
 sph_status sph_gl_draw_spheres(sph_gl *gl, const sph_view *view, size_t n,
                                const float *xyz, float radius,
                                const unsigned char *rgb,
                                const double *clip_plane, sph_image *img,
                                sph_error *err) {
-  sph_gl_layer layer = {n, xyz, radius, rgb, clip_plane, 0, NULL};
+  sph_gl_layer layer = {n, xyz, radius, rgb, clip_plane, 0, NULL, NULL};
   return sph_gl_draw_layers(gl, view, &layer, 1, img, err);
 }
 
@@ -525,19 +728,23 @@ void sph_gl_destroy(sph_gl *gl) {
     return;
   /* GL objects die with the context; release them explicitly anyway */
   if (gl->ctx && make_current(gl, NULL) == SPH_OK) {
-    if (gl->program)
-      glDeleteProgram(gl->program);
-    GLuint bufs[4] = {gl->quad_vbo, gl->centre_vbo, gl->colour_vbo,
-                      gl->scale_vbo};
-    GLuint rbs[2] = {gl->colour_rb, gl->depth_rb};
-    glDeleteBuffers(4, bufs);
+    if (gl->prog.id)
+      glDeleteProgram(gl->prog.id);
+    if (gl->tag.id)
+      glDeleteProgram(gl->tag.id);
+    GLuint bufs[5] = {gl->quad_vbo, gl->centre_vbo, gl->colour_vbo,
+                      gl->scale_vbo, gl->key_vbo};
+    GLuint rbs[3] = {gl->colour_rb, gl->depth_rb, gl->tag_rb};
+    GLuint fbos[2] = {gl->fbo, gl->tag_fbo};
+    glDeleteBuffers(5, bufs);
     glDeleteVertexArrays(1, &gl->vao);
-    glDeleteFramebuffers(1, &gl->fbo);
-    glDeleteRenderbuffers(2, rbs);
+    glDeleteFramebuffers(2, fbos);
+    glDeleteRenderbuffers(3, rbs);
     OSMesaMakeCurrent(NULL, NULL, 0, 0, 0);
   }
   if (gl->ctx)
     OSMesaDestroyContext(gl->ctx);
   free(gl->readback);
+  free(gl->px);
   free(gl);
 }

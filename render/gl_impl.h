@@ -20,9 +20,9 @@
 
 #include <stddef.h>
 
-#include "sph/status.h"
-
+#include "sph/composite.h"
 #include "sph/image.h"
+#include "sph/status.h"
 
 /* Background grey of every frame, 0-255 per channel (alpha is 255). */
 #define SPH_GL_BACKGROUND 237
@@ -113,6 +113,7 @@ typedef struct sph_gl_layer {
   const double *clip_plane; /* NULL: no clip */
   int flat;                 /* 1: the colour unshaded (a flat silhouette) */
   const float *scale;       /* per sphere factor on radius, or NULL (1) */
+  const uint32_t *key;      /* tagged draws: each sphere's serial draw index */
 } sph_gl_layer;
 
 /* Draws nlayers layers into one frame, in order: each layer is depth-tested
@@ -124,6 +125,16 @@ typedef struct sph_gl_layer {
 sph_status sph_gl_draw_layers(sph_gl *gl, const sph_view *view,
                               const sph_gl_layer *layers, int nlayers,
                               sph_image *img, sph_error *err);
+
+/* sph_gl_draw_layers for a frame composited over ranks (sph/composite.h):
+ * *px points to the context's width * height pixels (top row first, valid
+ * until the next draw) holding the colour, layer (i + 1, 0 for the
+ * background), window depth bits and key of the fragment that won each
+ * pixel, the layers' spheres drawn in the order given (ascending keys give
+ * the serial winner at a depth tie). Every layer with spheres needs keys. */
+sph_status sph_gl_draw_tagged(sph_gl *gl, const sph_view *view,
+                              const sph_gl_layer *layers, int nlayers,
+                              const sph_composite_px **px, sph_error *err);
 
 /* Releases the context and its buffers. Accepts NULL. */
 void sph_gl_destroy(sph_gl *gl);

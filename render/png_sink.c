@@ -41,6 +41,7 @@
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +49,8 @@
 
 #include "gl_impl.h"
 #include "overlay_impl.h"
+#include "sph/composite.h"
+#include "sph/domain.h"
 #include "sph/geometry.h"
 #include "sph/image.h"
 #include "sph/render.h"
@@ -55,6 +58,8 @@
 
 /* One frame as the simulation thread hands it to the renderer. */
 typedef struct png_frame {
+  size_t m;      /* the kept particles (over ranks: this rank's) */
+  uint32_t *key; /* over ranks: their particle ids (the serial draw order) */
   float *xyz;    /* the kept particles' current positions, in index order */
   float *scale;  /* their radius factors (J^(1/d)), or NULL without J */
   double *value; /* their colour values (NaN: none) */
@@ -100,6 +105,16 @@ typedef struct png_sink {
   unsigned char *rgb;
   /* hand-over between the threads, under mu */
   int threaded, locks_made, started;
+  /* over MPI ranks (sort-last): each rank draws its particles, the tagged
+   * images are composited onto rank 0, which writes the frame */
+  sph_domain *domain; /* NULL: a serial run */
+  int rank;
+  size_t cap;            /* particles a rank may hold */
+  double *cut_c;         /* cut: per body sums of X (3) and count */
+  int cut_axis;          /* cut: the axis closest to the view */
+  double cut_sign;       /* cut: its direction */
+  int64_t *order;        /* (id, index) of each owned particle */
+  sph_composite_px *cpx; /* rank 0: the composite */
   pthread_t thread;
   pthread_mutex_t mu;
   pthread_cond_t cv;
@@ -255,6 +270,7 @@ static void png_view(const sph_sim *sim, sph_view *v, double lo[3],
       lo[k] = fmin(lo[k], X[3 * a + k]);
       hi[k] = fmax(hi[k], X[3 * a + k]);
     }
+  sph_composite_minmax(sim->domain, lo, hi, 3); /* over the ranks */
   png_pad(sim->dp, lo, hi);
   if (!(c->given && c->has_position)) {
     png_fit(s, lo, hi, v);
@@ -302,37 +318,63 @@ static void png_view(const sph_sim *sim, sph_view *v, double lo[3],
   }
 }
 
-/* cut: half: per body, the particles behind its reference centroid along
- * the coordinate axis closest to the view direction (a flat cut face on
- * lattice bodies, looking at the camera; keep[a] = 1); all otherwise. */
-static sph_status cut_mask(const sph_sim *sim, const sph_view *v,
-                           unsigned char *keep, sph_error *err) {
+/* cut: half: per body, the sums of the reference positions and the
+ * particle count (*c, 4 per body; over MPI ranks summed in rank order, the
+ * centroid then equal to the serial one to round-off, far inside the
+ * keeping tolerance), the coordinate axis closest to the view direction
+ * and its sign; *c NULL without a cut. */
+static sph_status cut_setup(const sph_sim *sim, const sph_view *v, double **c,
+                            int *axis, double *sign, sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_particles *ps = sim->ps;
   const double *X = ps->field[SPH_FIELD_POSITION0];
-  memset(keep, 1, ps->n);
+  *c = NULL;
   if (!s->output.png.cut_half)
     return SPH_OK;
-  double *c = calloc(4 * (s->nbodies ? s->nbodies : 1), sizeof *c);
-  if (!c)
+  size_t nb = s->nbodies ? s->nbodies : 1;
+  double *cs = calloc(4 * nb, sizeof *cs);
+  if (!cs)
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   for (size_t a = 0; a < ps->n; ++a) {
-    double *cb = c + 4 * ps->body[a];
+    double *cb = cs + 4 * ps->body[a];
     for (int k = 0; k < 3; ++k)
       cb[k] += X[3 * a + k];
     cb[3] += 1.0;
   }
-  int axis = 0;
+  for (size_t b = 0; sim->domain && b < nb; ++b)
+    sph_domain_sum(sim->domain, cs + 4 * b, 4);
+  *axis = 0;
   double f[3];
   for (int k = 0; k < 3; ++k) {
     f[k] = v->target[k] - v->eye[k];
-    axis = fabs(f[k]) > fabs(f[axis]) ? k : axis;
+    *axis = fabs(f[k]) > fabs(f[*axis]) ? k : *axis;
   }
-  double sign = f[axis] < 0.0 ? -1.0 : 1.0, tol = 1e-6 * sim->dp;
-  for (size_t a = 0; a < ps->n; ++a) {
-    const double *cb = c + 4 * ps->body[a];
-    keep[a] = sign * (X[3 * a + axis] - cb[axis] / cb[3]) >= -tol;
-  }
+  *sign = f[*axis] < 0.0 ? -1.0 : 1.0;
+  *c = cs;
+  return SPH_OK;
+}
+
+/* Whether the cut keeps particle a (reference positions X, bodies body):
+ * it lies behind its body's reference centroid (a flat cut face on lattice
+ * bodies, looking at the camera); every particle without a cut. */
+static int cut_keeps(const double *c, int axis, double sign, double dp,
+                     const double *X, const int32_t *body, size_t a) {
+  if (!c)
+    return 1;
+  const double *cb = c + 4 * body[a];
+  return sign * (X[3 * a + axis] - cb[axis] / cb[3]) >= -1e-6 * dp;
+}
+
+/* keep[a] for each particle of sim (collective over MPI ranks). */
+static sph_status cut_mask(const sph_sim *sim, const sph_view *v,
+                           unsigned char *keep, sph_error *err) {
+  const sph_particles *ps = sim->ps;
+  double *c, sign = 1.0;
+  int axis = 0;
+  SPH_TRY(cut_setup(sim, v, &c, &axis, &sign, err));
+  for (size_t a = 0; a < ps->n; ++a)
+    keep[a] = (unsigned char)cut_keeps(
+        c, axis, sign, sim->dp, ps->field[SPH_FIELD_POSITION0], ps->body, a);
   free(c);
   return SPH_OK;
 }
@@ -402,9 +444,14 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
   free(keep);
   if (st != SPH_OK)
     return st;
-  if (ps->n > 0 && kept == 0) {
+  uint64_t counts[2] = {kept, seen}; /* over MPI ranks */
+  sph_composite_sum_u64(sim->domain, counts, 2);
+  kept = (size_t)counts[0];
+  seen = (size_t)counts[1];
+  size_t N = sph_domain_particles(sim->domain, ps);
+  if (N > 0 && kept == 0) {
     snprintf(msg, sizeof msg, "the clip plane keeps none of the %zu particles",
-             ps->n);
+             N);
     return png_error(png_node(s, "clip"), err, msg);
   }
   if (kept > 0 && seen == 0) {
@@ -426,13 +473,11 @@ static const unsigned char ghost_rim[3] = {168, 170, 178};
 #define GHOST_FILL 0.72
 #define GHOST_RIM 0.84
 
-/* Renders one snapshot into frames/<scene>_NNNN.png: colours, the sphere
- * pass, the overlay, the file (temporary name, then renamed). Errors name
- * the file. Runs on the render thread (or the caller's without one). */
-static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
-  char path[1300];
-  snprintf(path, sizeof path, "%s/%s_%04d.png", p->dir, p->name, fr->index);
-  size_t m = p->nkeep;
+/* The colours of the frame's kept particles and its three layers: the
+ * outline's rim and fill (ghost), then the particles. */
+static void png_layers(png_sink *p, const png_frame *fr,
+                       sph_gl_layer layers[3]) {
+  size_t m = fr->m;
   double lo = fr->lo, hi = fr->hi;
   for (size_t i = 0; i < m; ++i) {
     double v = fr->value[i];
@@ -444,17 +489,65 @@ static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
   double dp = p->dp;
   const double *plane = p->clip ? p->plane : NULL;
   size_t ng = p->ghost ? m : 0;
-  sph_gl_layer layers[3] = {
-      {ng, p->ghost_xyz, (float)(GHOST_RIM * dp), p->ghost_rim, plane, 1, NULL},
-      {ng, p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1,
-       NULL},
-      {m, fr->xyz, (float)(0.5 * dp), p->rgb, plane, 0, fr->scale}};
+  layers[0] = (sph_gl_layer){
+      ng,   p->ghost_xyz, (float)(GHOST_RIM * dp), p->ghost_rim, plane, 1,
+      NULL, fr->key};
+  layers[1] = (sph_gl_layer){
+      ng,   p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1,
+      NULL, fr->key};
+  layers[2] = (sph_gl_layer){m,     fr->xyz, (float)(0.5 * dp), p->rgb,
+                             plane, 0,       fr->scale,         fr->key};
+}
+
+static sph_status png_overlay_write(png_sink *p, const png_frame *fr,
+                                    const char *path, sph_error *err);
+
+/* Renders one snapshot into frames/<scene>_NNNN.png: colours, the sphere
+ * pass, the overlay, the file (temporary name, then renamed). Errors name
+ * the file. Runs on the render thread (or the caller's without one). */
+static sph_status png_render(png_sink *p, const png_frame *fr, sph_error *err) {
+  char path[1300];
+  snprintf(path, sizeof path, "%s/%s_%04d.png", p->dir, p->name, fr->index);
+  sph_gl_layer layers[3];
+  png_layers(p, fr, layers);
   sph_error gerr;
   sph_status st =
       sph_gl_draw_layers(p->gl, &fr->view, layers, 3, &p->img, &gerr);
   if (st != SPH_OK)
     return sph_error_at(err, st, path, 0, 0, NULL, "%s", gerr.message);
-  /* overlay: colour bar at the right, label block at the top left */
+  return png_overlay_write(p, fr, path, err);
+}
+
+/* The same over MPI ranks (collective, on the simulation thread): each rank
+ * draws its kept particles tagged with their ids, the images are
+ * composited by depth onto rank 0 (sph_composite_reduce), which draws the
+ * overlay and writes the file. */
+static sph_status png_render_ranks(png_sink *p, const png_frame *fr,
+                                   sph_error *err) {
+  char path[1300];
+  snprintf(path, sizeof path, "%s/%s_%04d.png", p->dir, p->name, fr->index);
+  sph_gl_layer layers[3];
+  png_layers(p, fr, layers);
+  sph_error gerr;
+  const sph_composite_px *px = NULL;
+  sph_status st = sph_gl_draw_tagged(p->gl, &fr->view, layers, 3, &px, &gerr);
+  if (st != SPH_OK)
+    sph_error_at(err, st, path, 0, 0, NULL, "%s", gerr.message);
+  SPH_TRY(sph_domain_agree(p->domain, st, err));
+  size_t npix = (size_t)p->width * (size_t)p->height;
+  SPH_TRY(sph_composite_reduce(p->domain, px, npix, p->cpx, err));
+  if (p->rank != 0)
+    return SPH_OK;
+  for (size_t i = 0; i < npix; ++i)
+    memcpy(p->img.rgba + 4 * i, &p->cpx[i].rgba, 4);
+  return png_overlay_write(p, fr, path, err);
+}
+
+/* The overlay over the drawn frame in p->img (colour bar at the right,
+ * label block at the top left, axes, scale bar), then the file. */
+static sph_status png_overlay_write(png_sink *p, const png_frame *fr,
+                                    const char *path, sph_error *err) {
+  double lo = fr->lo, hi = fr->hi;
   int H = p->img.height, W = p->img.width;
   char label[256];
   sph_colorbar cb = {.map = p->map,
@@ -584,9 +677,9 @@ static void png_stop(png_sink *p) {
   p->started = 0;
 }
 
-/* Allocates and fills everything but the renderer. */
-static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
-                            sph_error *err) {
+/* The frames folder, the buffers a rank needs and the colour policy. */
+static sph_status png_setup_buffers(png_sink *p, const sph_sim *sim,
+                                    const char *dir, sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_png_output *o = &s->output.png;
   snprintf(p->dir, sizeof p->dir, "%s/frames", dir);
@@ -594,14 +687,31 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   if (mkdir(p->dir, 0777) != 0 && errno != EEXIST)
     return sph_error_at(err, SPH_ERR_IO, p->dir, 0, 0, NULL,
                         "cannot create the frames folder: %s", strerror(errno));
-  size_t n = sim->ps->n ? sim->ps->n : 1;
+  /* over MPI ranks: room for the most particles a rank may hold */
+  p->domain = sim->domain;
+  p->rank = sph_domain_rank(sim->domain);
+  p->cap = sph_domain_capacity(sim->domain, sim->ps);
+  if (p->domain && sph_domain_particles(p->domain, sim->ps) > UINT32_MAX)
+    return sph_error_set(err, SPH_ERR_RANGE,
+                         "png sink: frames over MPI ranks draw at most %lu "
+                         "particles",
+                         (unsigned long)UINT32_MAX);
+  size_t n = p->cap ? p->cap : 1;
   p->keep = malloc(n);
   if (!p->keep)
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   p->width = o->width;
   p->height = o->height;
   p->dp = sim->dp;
-  SPH_TRY(sph_image_create(&p->img, o->width, o->height, err));
+  if (p->rank == 0) /* the frame rank 0 writes */
+    SPH_TRY(sph_image_create(&p->img, o->width, o->height, err));
+  if (p->domain) {
+    size_t npix = (size_t)o->width * (size_t)o->height;
+    p->cpx = p->rank == 0 ? malloc(npix * sizeof *p->cpx) : NULL;
+    p->order = malloc(2 * n * sizeof *p->order);
+    if ((p->rank == 0 && !p->cpx) || !p->order)
+      return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  }
   /* field, range policy and map */
   sph_field f = (sph_field)o->color_field;
   p->field = f;
@@ -640,6 +750,18 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
   snprintf(p->title, sizeof p->title, "%s%s%s%s%s", sph_field_name(f),
            p->ncomp > 1 ? " magnitude" : "", unit && *unit ? " [" : "",
            unit ? unit : "", unit && *unit ? "]" : "");
+  return SPH_OK;
+}
+
+/* Allocates and fills everything but the renderer; over MPI ranks every
+ * rank fails when one does before the reductions (collective). */
+static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
+                            sph_error *err) {
+  sph_status st = png_setup_buffers(p, sim, dir, err);
+  SPH_TRY(sph_domain_agree(sim->domain, st, err));
+  const sph_scene *s = sim->scene;
+  const sph_png_output *o = &s->output.png;
+  size_t n = p->cap ? p->cap : 1;
   /* camera, cutaways and the reference outline */
   png_view(sim, &p->view, p->fit_lo, p->fit_hi);
   SPH_TRY(sph_view_check(&p->view, err));
@@ -657,16 +779,21 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
       break;
     p->time_decimals++;
   }
-  SPH_TRY(cut_mask(sim, &p->view, p->keep, err));
-  for (size_t a = 0; a < sim->ps->n; ++a)
+  SPH_TRY(cut_setup(sim, &p->view, &p->cut_c, &p->cut_axis, &p->cut_sign, err));
+  const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+  for (size_t a = 0; a < sim->ps->n; ++a) {
+    p->keep[a] = (unsigned char)cut_keeps(p->cut_c, p->cut_axis, p->cut_sign,
+                                          p->dp, X, sim->ps->body, a);
     p->nkeep += p->keep[a];
+  }
   p->clip = o->clip;
   p->ghost = o->ghost;
   for (int k = 0; k < 3; ++k)
     p->plane[k] = -o->clip_normal[k];
   p->plane[3] = o->clip_at;
-  /* the snapshots and the colours of the kept particles */
-  size_t m = p->nkeep ? p->nkeep : 1;
+  /* the snapshots and the colours of the kept particles (over ranks: of
+   * every particle a rank may hold) */
+  size_t m = p->domain ? n : p->nkeep ? p->nkeep : 1;
   p->rgb = malloc(3 * m);
   if (!p->rgb)
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
@@ -676,25 +803,28 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
     p->slot[i].xyz = malloc(3 * m * sizeof *p->slot[i].xyz);
     p->slot[i].value = malloc(m * sizeof *p->slot[i].value);
     p->slot[i].scale = with_j ? malloc(m * sizeof *p->slot[i].scale) : NULL;
-    if (!p->slot[i].xyz || !p->slot[i].value || (with_j && !p->slot[i].scale))
+    p->slot[i].key = p->domain ? malloc(m * sizeof *p->slot[i].key) : NULL;
+    if (!p->slot[i].xyz || !p->slot[i].value || (with_j && !p->slot[i].scale) ||
+        (p->domain && !p->slot[i].key))
       return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   }
   if (o->ghost) {
-    const double *X = sim->ps->field[SPH_FIELD_POSITION0];
     p->ghost_xyz = malloc(3 * m * sizeof *p->ghost_xyz);
     p->ghost_rim = malloc(3 * m);
     p->ghost_fill = malloc(3 * m);
     if (!p->ghost_xyz || !p->ghost_rim || !p->ghost_fill)
       return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
-    size_t g = 0;
-    for (size_t a = 0; a < sim->ps->n; ++a) {
-      if (!p->keep[a])
-        continue;
+    for (size_t g = 0; g < m; ++g) /* over ranks: set at every frame */
       for (int k = 0; k < 3; ++k) {
-        p->ghost_xyz[3 * g + k] = (float)X[3 * a + k];
         p->ghost_rim[3 * g + k] = ghost_rim[k];
         p->ghost_fill[3 * g + k] = ghost_fill[k];
       }
+    size_t g = 0;
+    for (size_t a = 0; !p->domain && a < sim->ps->n; ++a) {
+      if (!p->keep[a])
+        continue;
+      for (int k = 0; k < 3; ++k)
+        p->ghost_xyz[3 * g + k] = (float)X[3 * a + k];
       ++g;
     }
   }
@@ -711,8 +841,10 @@ static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   sink->data = p;
   sink->thread_seconds = 0.0;
-  p->threaded = threaded;
-  SPH_TRY(png_setup(p, sim, dir, err));
+  p->threaded = threaded && !sim->domain; /* collectives: one thread */
+  threaded = p->threaded;
+  sph_status st = png_setup(p, sim, dir, err);
+  SPH_TRY(sph_domain_agree(sim->domain, st, err)); /* before the replay's */
   png_replay(p, sim, dir, sink->resume_frames);
   if (!threaded)
     return png_renderer_create(p, err);
@@ -743,19 +875,30 @@ static sph_status png_open_sync(sph_sink *sink, const sph_sim *sim,
   return png_open_as(sink, sim, dir, 0, err);
 }
 
-/* Follow camera: refit when a drawn particle leaves the framed box, or when
- * the bodies have shrunk to under half of it along every axis (hysteresis:
- * the view holds still while the motion stays inside). */
-static void png_follow(png_sink *p, const float *xyz, size_t m) {
-  double lo[3] = {INFINITY, INFINITY, INFINITY};
-  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+/* The box of m positions (lo > hi when m is 0). */
+static void png_box(const float *xyz, size_t m, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = INFINITY;
+    hi[k] = -INFINITY;
+  }
   for (size_t i = 0; i < m; ++i)
     for (int k = 0; k < 3; ++k) {
       lo[k] = fmin(lo[k], xyz[3 * i + k]);
       hi[k] = fmax(hi[k], xyz[3 * i + k]);
     }
-  if (!m)
+}
+
+/* Follow camera: refit when a drawn particle leaves the framed box [lo, hi]
+ * of the drawn particles, or when the bodies have shrunk to under half of
+ * it along every axis (hysteresis: the view holds still while the motion
+ * stays inside). Nothing for an empty box. */
+static void png_follow(png_sink *p, const double box_lo[3],
+                       const double box_hi[3]) {
+  if (!(box_lo[0] <= box_hi[0]))
     return;
+  double lo[3], hi[3];
+  memcpy(lo, box_lo, sizeof lo);
+  memcpy(hi, box_hi, sizeof hi);
   int outside = 0, small = 1;
   for (int k = 0; k < 3; ++k) {
     double fit = p->fit_hi[k] - p->fit_lo[k];
@@ -794,6 +937,10 @@ static void png_replay(png_sink *p, const sph_sim *sim, const char *dir,
   int grow = p->mode == PNG_RANGE_AUTO || p->mode == PNG_RANGE_SYMMETRIC;
   if (frames <= 0 || !(p->follow || grow) || !sim->scene->output.vtk)
     return;
+  /* over MPI ranks each rank reads its own pieces, which hold the
+   * particles it owns now only when they do not migrate */
+  if (sph_domain_migrates(p->domain))
+    return;
   const sph_particles *ps = sim->ps;
   size_t n = ps->n, m = 0;
   double *x = malloc(3 * (n ? n : 1) * sizeof *x);
@@ -804,10 +951,15 @@ static void png_replay(png_sink *p, const sph_sim *sim, const char *dir,
     char path[1300];
     double t;
     sph_error err;
-    snprintf(path, sizeof path, "%s/%s_%04d.vtp", dir, sim->scene->name, i);
-    if (sph_vtp_read(path, n, x,
-                     grow ? sph_field_name((sph_field)p->field) : NULL,
-                     p->ncomp, v, &t, &err) != SPH_OK)
+    if (p->domain)
+      snprintf(path, sizeof path, "%s/%s_%04d_p%d.vtp", dir, sim->scene->name,
+               i, p->rank);
+    else
+      snprintf(path, sizeof path, "%s/%s_%04d.vtp", dir, sim->scene->name, i);
+    int ok = sph_vtp_read(path, n, x,
+                          grow ? sph_field_name((sph_field)p->field) : NULL,
+                          p->ncomp, v, &t, &err) == SPH_OK;
+    if (!sph_domain_min(p->domain, ok)) /* every rank's piece */
       break;
     double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
     m = 0;
@@ -826,73 +978,57 @@ static void png_replay(png_sink *p, const sph_sim *sim, const char *dir,
         xyz[3 * m + c] = (float)x[3 * j + c];
       ++m;
     }
+    double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
+    png_box(xyz, m, lo, hi);
+    lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
+    sph_composite_minmax(p->domain, lo, hi, 5);
     if (grow)
-      png_grow_range(p, vmin, vmax, amax);
+      png_grow_range(p, lo[3], hi[3], hi[4]);
     if (p->follow)
-      png_follow(p, xyz, m);
+      png_follow(p, lo, hi);
   }
   free(x);
   free(v);
   free(xyz);
 }
 
-/* Copies what frame fr needs into snapshot s and advances the range (frame
- * order, on the simulation thread). A non-finite position fails here, as
- * the sphere pass would, so the frame is not written. */
-static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
-                               sph_error *err) {
-  const double *field = fr->ps->field[p->field];
-  const double *x = fr->ps->field[SPH_FIELD_POSITION];
-  const double *J = fr->ps->field[SPH_FIELD_JACOBIAN];
-  size_t n = fr->ps->n, m = 0;
-  int nc = p->ncomp;
-  double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
-  double c0 = isfinite(p->centre) ? p->centre : 0.0;
-  size_t nf = 0;
-  for (size_t j = 0; j < n; ++j) { /* creation order, as the VTK files */
-    size_t a = sph_particles_slot(fr->ps, j);
-    double v = field ? sph_png_value(field, nc, a) : NAN;
-    if (isfinite(v)) {
-      vmin = fmin(vmin, v);
-      vmax = fmax(vmax, v);
-      amax = fmax(amax, fabs(v - c0));
-      p->work[nf++] = v;
-    }
-    if (!p->keep[a])
-      continue;
-    for (int c = 0; c < 3; ++c)
-      s->xyz[3 * m + c] = (float)x[3 * a + c];
-    if (s->scale && J) { /* the sphere of the particle's volume V0 J */
-      double f = p->dim == 3 ? cbrt(J[a]) : sqrt(fmax(J[a], 0.0));
-      s->scale[m] = (float)(f > 0.5 ? (f < 2.0 ? f : 2.0) : 0.5);
-    } else if (s->scale) {
-      s->scale[m] = 1.0f;
-    }
-    s->value[m++] = v;
+/* The k[i]-th smallest of the frame's nf finite values, i < nk: those in
+ * p->work (nlocal of them; over MPI ranks every rank's). */
+static void png_kth(png_sink *p, size_t nlocal, size_t nf, const uint64_t *k,
+                    int nk, double *out) {
+  if (p->domain) {
+    sph_composite_select(p->domain, p->work, nlocal, k, nk, out);
+    return;
   }
-  for (size_t i = 0; i < 3 * m; ++i)
-    if (!isfinite(s->xyz[i]))
-      return sph_error_set(err, SPH_ERR_NUMERIC,
-                           "render: sphere %zu has a non-finite centre", i / 3);
-  if (p->follow)
-    png_follow(p, s->xyz, m);
-  s->view = p->view;
-  /* the range from the frames with a varying field */
+  for (int i = 0; i < nk; ++i)
+    out[i] = select_kth(p->work, nf, (size_t)k[i]);
+}
+
+/* The frame's colour range from its values' least, greatest and largest
+ * distance from the centre and its nf finite values (p->work: nlocal of
+ * them), as the range policy says, and the bar's end arrows. */
+static void png_colour_range(png_sink *p, png_frame *s, double vmin,
+                             double vmax, double amax, size_t nlocal,
+                             size_t nf) {
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
   int diverging = isfinite(p->centre);
   if (p->mode == PNG_RANGE_ROBUST && vmax > vmin) {
-    size_t k1 = (size_t)floor(0.01 * (double)(nf - 1) + 0.5);
-    size_t k99 = (size_t)floor(0.99 * (double)(nf - 1) + 0.5);
+    uint64_t k[2] = {(uint64_t)floor(0.01 * (double)(nf - 1) + 0.5),
+                     (uint64_t)floor(0.99 * (double)(nf - 1) + 0.5)};
     double lo_f, hi_f;
     if (diverging) {
-      for (size_t i = 0; i < nf; ++i)
+      for (size_t i = 0; i < nlocal; ++i)
         p->work[i] = fabs(p->work[i] - c0);
-      double w = select_kth(p->work, nf, k99);
+      double w;
+      png_kth(p, nlocal, nf, k + 1, 1, &w);
       w = w > 0.0 ? w : amax;
       lo_f = c0 - w;
       hi_f = c0 + w;
     } else {
-      lo_f = select_kth(p->work, nf, k1);
-      hi_f = select_kth(p->work, nf, k99);
+      double q[2];
+      png_kth(p, nlocal, nf, k, 2, q);
+      lo_f = q[0];
+      hi_f = q[1];
       if (!(hi_f > lo_f)) {
         lo_f = vmin;
         hi_f = vmax;
@@ -909,6 +1045,125 @@ static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
   /* some finite value outside the range: the bar's end arrows */
   s->clamped_low = vmin < s->lo;
   s->clamped_high = vmax > s->hi;
+}
+
+/* Particle a's position, radius factor and colour value as the m-th drawn
+ * sphere of snapshot s. */
+static void png_take(const png_sink *p, const sph_particles *ps, size_t a,
+                     double v, png_frame *s, size_t m) {
+  const double *x = ps->field[SPH_FIELD_POSITION];
+  const double *J = ps->field[SPH_FIELD_JACOBIAN];
+  for (int c = 0; c < 3; ++c)
+    s->xyz[3 * m + c] = (float)x[3 * a + c];
+  if (s->scale && J) { /* the sphere of the particle's volume V0 J */
+    double f = p->dim == 3 ? cbrt(J[a]) : sqrt(fmax(J[a], 0.0));
+    s->scale[m] = (float)(f > 0.5 ? (f < 2.0 ? f : 2.0) : 0.5);
+  } else if (s->scale) {
+    s->scale[m] = 1.0f;
+  }
+  s->value[m] = v;
+}
+
+/* A finite colour value v into the frame's least, greatest, largest
+ * distance from the centre c0 and the values p->work (nf of them). */
+static void png_count(png_sink *p, double v, double c0, double *vmin,
+                      double *vmax, double *amax, size_t *nf) {
+  if (!isfinite(v))
+    return;
+  *vmin = fmin(*vmin, v);
+  *vmax = fmax(*vmax, v);
+  *amax = fmax(*amax, fabs(v - c0));
+  p->work[(*nf)++] = v;
+}
+
+/* A non-finite position fails here, as the sphere pass would, so the
+ * frame is not written. */
+static sph_status png_finite(const png_frame *s, size_t m, sph_error *err) {
+  for (size_t i = 0; i < 3 * m; ++i)
+    if (!isfinite(s->xyz[i]))
+      return sph_error_set(err, SPH_ERR_NUMERIC,
+                           "render: sphere %zu has a non-finite centre", i / 3);
+  return SPH_OK;
+}
+
+/* Copies what frame fr needs into snapshot s and advances the range (frame
+ * order, on the simulation thread). */
+static sph_status png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
+                               sph_error *err) {
+  const double *field = fr->ps->field[p->field];
+  size_t n = fr->ps->n, m = 0;
+  int nc = p->ncomp;
+  double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  size_t nf = 0;
+  for (size_t j = 0; j < n; ++j) { /* creation order, as the VTK files */
+    size_t a = sph_particles_slot(fr->ps, j);
+    double v = field ? sph_png_value(field, nc, a) : NAN;
+    png_count(p, v, c0, &vmin, &vmax, &amax, &nf);
+    if (!p->keep[a])
+      continue;
+    png_take(p, fr->ps, a, v, s, m++);
+  }
+  SPH_TRY(png_finite(s, m, err));
+  if (p->follow) {
+    double lo[3], hi[3];
+    png_box(s->xyz, m, lo, hi);
+    png_follow(p, lo, hi);
+  }
+  s->view = p->view;
+  s->m = m;
+  png_colour_range(p, s, vmin, vmax, amax, nf, nf);
+  s->time = fr->time;
+  s->index = fr->index;
+  return SPH_OK;
+}
+
+static int cmp_first_i64(const void *pa, const void *pb) {
+  int64_t a = *(const int64_t *)pa, b = *(const int64_t *)pb;
+  return (a > b) - (a < b);
+}
+
+/* The same over MPI ranks (collective): this rank's particles in the
+ * serial draw order (by id) with their ids as keys, the cut evaluated on
+ * them (they migrate), the box, value range, counts and percentiles
+ * reduced over the ranks. */
+static sph_status png_snapshot_ranks(png_sink *p, const sph_frame *fr,
+                                     png_frame *s, sph_error *err) {
+  const sph_particles *ps = fr->ps;
+  const double *field = ps->field[p->field];
+  const double *X = ps->field[SPH_FIELD_POSITION0];
+  size_t n = ps->n, m = 0, nf = 0;
+  int nc = p->ncomp;
+  double vmin = INFINITY, vmax = -INFINITY, amax = 0.0;
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  for (size_t a = 0; a < n; ++a) {
+    p->order[2 * a] = ps->id[a];
+    p->order[2 * a + 1] = (int64_t)a;
+  }
+  qsort(p->order, n, 2 * sizeof *p->order, cmp_first_i64);
+  for (size_t i = 0; i < n; ++i) {
+    size_t a = (size_t)p->order[2 * i + 1];
+    double v = field ? sph_png_value(field, nc, a) : NAN;
+    png_count(p, v, c0, &vmin, &vmax, &amax, &nf);
+    if (!cut_keeps(p->cut_c, p->cut_axis, p->cut_sign, p->dp, X, ps->body, a))
+      continue;
+    s->key[m] = (uint32_t)ps->id[a];
+    for (int k = 0; p->ghost && k < 3; ++k)
+      p->ghost_xyz[3 * m + k] = (float)X[3 * a + k];
+    png_take(p, ps, a, v, s, m++);
+  }
+  SPH_TRY(sph_domain_agree(p->domain, png_finite(s, m, err), err));
+  double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
+  png_box(s->xyz, m, lo, hi);
+  lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
+  sph_composite_minmax(p->domain, lo, hi, 5);
+  uint64_t all = nf;
+  sph_composite_sum_u64(p->domain, &all, 1);
+  if (p->follow)
+    png_follow(p, lo, hi);
+  s->view = p->view;
+  s->m = m;
+  png_colour_range(p, s, lo[3], hi[3], hi[4], nf, (size_t)all);
   s->time = fr->time;
   s->index = fr->index;
   return SPH_OK;
@@ -918,6 +1173,10 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
                             sph_error *err) {
   png_sink *p = sink->data;
   png_frame *s = &p->slot[p->next];
+  if (p->domain) { /* over MPI ranks: composited on this thread */
+    SPH_TRY(png_snapshot_ranks(p, fr, s, err));
+    return png_render_ranks(p, s, err);
+  }
   SPH_TRY(png_snapshot(p, fr, s, err));
   if (!p->threaded)
     return png_render(p, s, err);
@@ -958,7 +1217,11 @@ static void png_destroy(sph_sink *sink) {
   free(p->rgb);
   free(p->keep);
   free(p->work);
+  free(p->cut_c);
+  free(p->order);
+  free(p->cpx);
   for (int i = 0; i < 2; ++i) {
+    free(p->slot[i].key);
     free(p->slot[i].xyz);
     free(p->slot[i].value);
     free(p->slot[i].scale);

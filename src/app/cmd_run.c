@@ -197,10 +197,13 @@ static void print_sink_times(const sph_sink *sinks, int nsinks, double wall) {
   printf(" of %.2f s wall\n", wall);
 }
 
-/* Over MPI ranks every rank writes its VTK piece; the other sinks run on
- * rank 0 only. */
+/* Over MPI ranks every rank writes its VTK piece and draws its particles
+ * into the frames (composited onto rank 0); the other sinks run on rank 0
+ * only. */
 static int piece_sink(const sph_sim *sim, const sph_sink *sink) {
-  return sim->domain && sink->ops == &sph_vtk_sink_ops;
+  return sim->domain &&
+         (sink->ops == &sph_vtk_sink_ops || sink->ops == &sph_png_sink_ops ||
+          sink->ops == &sph_png_sink_sync_ops);
 }
 
 /* Over MPI ranks without a whole view, rank 0's probes read a set of their
@@ -317,14 +320,11 @@ static sph_status probe_view_create(probe_view *pv, sph_sim *sim,
   return probe_view_fill(pv, sim, 1, err);
 }
 
-/* The fields rank 0's whole view holds: the frames' positions, J and
- * colour, the probes' fields (the VTK pieces are written per rank). */
+/* The fields rank 0's whole view holds: the probes' fields (the VTK
+ * pieces are written and the frames drawn per rank). */
 static unsigned long whole_fields(const sph_sim *sim) {
   const sph_scene *s = sim->scene;
   unsigned long f = 0;
-  if (s->output.png.enabled)
-    f |= 1ul << SPH_FIELD_POSITION | 1ul << SPH_FIELD_JACOBIAN |
-         1ul << s->output.png.color_field;
   for (size_t k = 0; k < s->output.nprobes; ++k)
     for (int i = 0; i < s->output.probes[k].nfields; ++i)
       f |= 1ul << s->output.probes[k].fields[i];

@@ -129,7 +129,7 @@ START_TEST(radius_factor_per_sphere) {
   const float c[3] = {0, 0, 0}, c2[3] = {0.5f, 0.5f, 0.0f};
   const unsigned char col[3] = {200, 60, 40};
   const float two = 2.0f, one = 1.0f;
-  sph_gl_layer l = {1, c, 0.25f, col, NULL, 0, &two};
+  sph_gl_layer l = {1, c, 0.25f, col, NULL, 0, &two, NULL};
   sph_error err;
   ck_assert_int_eq(sph_gl_draw_layers(gl, &v, &l, 1, &img, &err), SPH_OK);
   check_disc(&img, 100.0, 100.0, 50.0);
@@ -230,8 +230,8 @@ START_TEST(layers_paint_over) {
   sph_gl *gl = context(200, 200);
   sph_image img = image_new(200, 200);
   sph_view v = front_view(1, 2.0, 5.0);
-  sph_gl_layer layers[2] = {{1, grey_c, 0.5f, grey, NULL, 1, NULL},
-                            {1, red_c, 0.5f, red, NULL, 0, NULL}};
+  sph_gl_layer layers[2] = {{1, grey_c, 0.5f, grey, NULL, 1, NULL, NULL},
+                            {1, red_c, 0.5f, red, NULL, 0, NULL, NULL}};
   sph_error err;
   ck_assert_int_eq(sph_gl_draw_layers(gl, &v, layers, 2, &img, &err), SPH_OK);
   int red_px = 0;
