@@ -30,8 +30,8 @@ int sph_domain_world_size(void);
 
 /* Partitions *ps (every particle, the same on every rank, in storage
  * order) over the ranks: *ps becomes this rank's owned particles in the
- * same relative order (rank 0's whole set for output, sph_domain_global, is
- * gathered back by sph_domain_whole_create). Ghosts are the particles of the
+ * same relative order (no rank keeps the whole set). Ghosts are the
+ * particles of the
  * same body within `support` of an owned one (strictly, as
  * sph_neighbors_build). Refuses a rank count for which a rank would hold more
  * ghosts than owned particles. */
@@ -47,12 +47,6 @@ void sph_domain_destroy(sph_domain *d);
 sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
                                    const int64_t *gidx, size_t N,
                                    double support, int dynamic, sph_error *err);
-/* Rank 0's whole set (sph_domain_global) from the owned sets ps of every
- * rank (collective): reference positions, volumes, initial velocities, ids,
- * bodies and flags at their storage indices, in the serial order. Made once
- * (a no-op after, and for NULL). */
-sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
-                                   sph_error *err);
 /* sph_domain_agree over every rank before a domain exists (st for one
  * rank). */
 sph_status sph_domain_world_agree(sph_status st, sph_error *err);
@@ -166,9 +160,6 @@ int sph_domain_migrates(const sph_domain *d);
 
 /* The particles of the whole run: over all ranks, ps->n for NULL. */
 size_t sph_domain_particles(const sph_domain *d, const sph_particles *ps);
-/* Rank 0 frees its whole set and the gather's buffers: a run whose outputs
- * read no whole view (sph_domain_gather must not be called after). */
-void sph_domain_drop_global(sph_domain *d);
 /* The other ranks' points (ncomp doubles each, the first 3 the position)
  * within `radius` of this rank's box of its n points pts, received into
  * *out (grown to *cap doubles when short) by rank, *m of them
@@ -198,16 +189,6 @@ sph_status sph_domain_gather_range(sph_domain *d, const int64_t *key,
                                    const double *rows, size_t n, int w,
                                    int64_t lo, size_t m, double *out,
                                    sph_error *err);
-/* Rank 0's whole particle set (NULL elsewhere and for NULL). */
-sph_particles *sph_domain_global(const sph_domain *d);
-/* Gathers the fields of `local` among those selected (every field until
- * sph_domain_gather_select) and the flags into rank 0's whole set, each
- * particle at its storage index of the serial run. */
-sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
-                             sph_error *err);
-/* The fields (bit 1ul << f) rank 0's outputs read from the whole set: only
- * these are allocated there and gathered. */
-void sph_domain_gather_select(sph_domain *d, unsigned long fields);
 
 /* ---- updated-Lagrangian runs (src/parallel/domain_dynamic.c) ----------
  * Their neighbourhoods change, so a dynamic domain is partitioned like the

@@ -141,12 +141,6 @@ const sph_method_ops *sph_method_find(const char *name);
 /* NULL-terminated list of every method. */
 const sph_method_ops *const *sph_method_list(void);
 
-/* Whether a run of scene s over MPI ranks needs rank 0 to hold a whole
- * view of the particles (gathered at each frame): none does now (the PNG
- * frames are drawn per rank and composited, a reference reads its
- * particles from their owners); the verdict, momenta and probes never did. */
-int sph_sim_needs_whole_view(const sph_scene *s);
-
 /* Builds particles, looks up and sets up the method (its option errors point
  * into the scene file). */
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,

@@ -206,7 +206,7 @@ static int piece_sink(const sph_sim *sim, const sph_sink *sink) {
           sink->ops == &sph_png_sink_sync_ops);
 }
 
-/* Over MPI ranks without a whole view, rank 0's probes read a set of their
+/* Over MPI ranks rank 0's probes read a set of their
  * particles only: the nearest to each probe in the reference configuration
  * (ties: the first created, as the probe sink picks them), by particle id,
  * their fields taken from their owners at every frame. */
@@ -320,22 +320,10 @@ static sph_status probe_view_create(probe_view *pv, sph_sim *sim,
   return probe_view_fill(pv, sim, 1, err);
 }
 
-/* The fields rank 0's whole view holds: the probes' fields (the VTK
- * pieces are written and the frames drawn per rank). */
-static unsigned long whole_fields(const sph_sim *sim) {
-  const sph_scene *s = sim->scene;
-  unsigned long f = 0;
-  for (size_t k = 0; k < s->output.nprobes; ++k)
-    for (int i = 0; i < s->output.probes[k].nfields; ++i)
-      f |= 1ul << s->output.probes[k].fields[i];
-  return f;
-}
-
 /* derive, then every sink and the verdict see the same frame; over MPI
  * ranks the energies and momenta are summed over them, every rank judges
- * its particles for the verdict and, when rank 0 needs a whole view, the
- * fields are gathered to rank 0, where `view` is the run seen whole (rank
- * 0's sinks) */
+ * its particles for the verdict and draws its part of the PNG frame, and
+ * rank 0's sinks see `view`, the run with its probes' particles */
 static sph_status output_frame(sph_sim *sim, sph_sim *view, probe_view *pv,
                                sph_sink *sinks, int nsinks, sph_verdict *v,
                                int index, sph_error *err) {
@@ -359,9 +347,7 @@ static sph_status output_frame(sph_sim *sim, sph_sim *view, probe_view *pv,
     sph_domain_sum(sim->domain, momentum, 6);
     fr.kinetic = whole.kinetic = e[0];
     fr.strain = whole.strain = e[1];
-    if (sph_sim_needs_whole_view(sim->scene))
-      SPH_TRY(sph_domain_gather(sim->domain, sim->ps, err));
-    else if (pv->ps)
+    if (pv->ps)
       SPH_TRY(probe_view_fill(pv, sim, 0, err));
     if (root) {
       sph_particles *all = view->ps;
@@ -484,14 +470,9 @@ int sph_cmd_run(int argc, char **argv) {
   sph_error_clear(&err);
   sph_status st = SPH_OK;
   char dir[1024];
-  /* rank 0's view of a distributed run: every particle, gathered, when
-   * an output reads one (sph_sim_create made it only then) */
-  int whole_view = sph_sim_needs_whole_view(scene);
-  sph_domain_gather_select(sim->domain, whole_view ? whole_fields(sim) : 0);
+  /* rank 0's view of a distributed run: its probes' particles (below) */
   sph_sim view = *sim;
   probe_view pv = {0};
-  if (sim->domain && root && whole_view)
-    view.ps = sph_domain_global(sim->domain);
   const sph_sim *whole = sim->domain ? &view : sim;
   if (args.resume && args.out && strcmp(args.resume, args.out)) {
     fprintf(stderr, "sph: --resume continues in its own folder; drop --out "
@@ -558,11 +539,8 @@ int sph_cmd_run(int argc, char **argv) {
   if (args.overwrite && !args.resume && root)
     remove_previous(dir, scene->name);
   sph_halo halo = sph_domain_halo(sim->domain); /* collective */
-  /* rank 0's whole set has the method's fields before the sinks open */
-  if (st == SPH_OK && whole_view)
-    st = sph_domain_gather(sim->domain, sim->ps, &err);
-  /* else its probes' particles, from their owners */
-  if (st == SPH_OK && sim->domain && !whole_view && scene->output.nprobes) {
+  /* rank 0's probes' particles, from their owners */
+  if (st == SPH_OK && sim->domain && scene->output.nprobes) {
     st = probe_view_create(&pv, sim, &err);
     if (st == SPH_OK && root)
       view.ps = pv.ps;

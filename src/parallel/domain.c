@@ -87,21 +87,8 @@ void sph_domain_set_ghost_base(sph_domain *d, size_t base) {
   if (d)
     d->base = base;
 }
-sph_particles *sph_domain_global(const sph_domain *d) {
-  return d ? d->all : NULL;
-}
 size_t sph_domain_particles(const sph_domain *d, const sph_particles *ps) {
   return d ? d->total : ps->n;
-}
-void sph_domain_drop_global(sph_domain *d) {
-  if (!d)
-    return;
-  sph_particles_destroy(d->all);
-  free(d->gbuf);
-  free(d->all_gidx);
-  d->all = NULL;
-  d->gbuf = NULL;
-  d->all_gidx = NULL;
 }
 
 sph_halo sph_domain_halo(sph_domain *d) {
@@ -134,11 +121,6 @@ void sph_domain_destroy(sph_domain *d) {
   free(d->send_idx);
   free(d->buf);
   free(d->req);
-  sph_domain_drop_global(d);
-  free(d->all_count);
-  free(d->all_off);
-  free(d->counts);
-  free(d->offs);
   free(d->sums);
   free(d->pbuf);
   sph_domain_dyn_destroy(d->dyn);
@@ -599,39 +581,6 @@ static sph_status exchange_plan(sph_domain *d, const int *gowner,
   return SPH_OK;
 }
 
-/* rank 0 learns every rank's owned storage indices (the gather's map) */
-static sph_status gather_plan(sph_domain *d, size_t N, sph_error *err) {
-  int R = d->size;
-  int fail = 0;
-  d->total = N;
-  if (d->rank == 0) {
-    d->all_count = malloc((size_t)R * sizeof(int));
-    d->all_off = malloc(((size_t)R + 1) * sizeof(int));
-    d->counts = malloc((size_t)R * sizeof(int));
-    d->offs = malloc((size_t)R * sizeof(int));
-    d->all_gidx = malloc((N ? N : 1) * sizeof(int64_t));
-    d->gbuf = malloc(9 * (N ? N : 1) * sizeof(double));
-    fail = !d->all_count || !d->all_off || !d->counts || !d->offs ||
-           !d->all_gidx || !d->gbuf;
-  }
-  sph_status st = fail ? sph_error_set(err, SPH_ERR_NOMEM, "gather") : SPH_OK;
-  SPH_TRY(sph_domain_agree(d, st, err));
-  sph_domain_gather_map(d);
-  return SPH_OK;
-}
-
-void sph_domain_gather_map(sph_domain *d) {
-  int R = d->size, n = (int)d->n;
-  MPI_Gather(&n, 1, MPI_INT, d->all_count, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (d->rank == 0) {
-    d->all_off[0] = 0;
-    for (int q = 0; q < R; ++q)
-      d->all_off[q + 1] = d->all_off[q] + d->all_count[q];
-  }
-  MPI_Gatherv(d->gidx, n, MPI_INT64_T, d->all_gidx, d->all_count, d->all_off,
-              MPI_INT64_T, 0, MPI_COMM_WORLD);
-}
-
 /* a halo larger than the domain (ng_support ghosts within one support):
  * more ranks than useful; then the exchange's plan from the ghosts'
  * owners (collective, agreed) */
@@ -680,7 +629,6 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
     d->rank = world_rank;
     d->size = world_size;
     d->dim = all->dim;
-    d->gathered = ~0ul;
     d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
     if (!d->sums)
       st = sph_error_set(err, SPH_ERR_NOMEM, "decomposition");
@@ -756,7 +704,7 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
     st = owned_set(all, d, cap > d->n ? cap : d->n, &mine, err);
   st = sph_domain_agree(d, st, err);
   if (st == SPH_OK)
-    st = gather_plan(d, N, err);
+    d->total = N;
   if (st == SPH_OK && dynamic)
     st = sph_domain_dyn_create(d, N, axis, cut, err);
   st = sph_domain_agree(d, st, err);
@@ -770,8 +718,6 @@ static sph_status domain_create(sph_domain **out, sph_particles **ps,
     sph_domain_destroy(d);
     return st;
   }
-  /* rank 0's whole set is gathered back when needed
-   * (sph_domain_whole_create) */
   sph_particles_destroy(all);
   *ps = mine;
   *out = d;
@@ -1059,7 +1005,6 @@ static sph_status share_create(sph_domain **out, sph_particles **ps,
     d->rank = world_rank;
     d->size = world_size;
     d->dim = dim;
-    d->gathered = ~0ul;
     d->sums = malloc((size_t)world_size * 16 * sizeof *d->sums);
   }
   sph_status st = d && d->sums && owner && count && send && axis && cut
@@ -1169,7 +1114,7 @@ static sph_status share_create(sph_domain **out, sph_particles **ps,
   free(own);
   st = sph_domain_agree(&world, st, err);
   if (st == SPH_OK)
-    st = gather_plan(d, N, err);
+    d->total = N;
   if (st == SPH_OK && dynamic)
     st = sph_domain_dyn_create(d, N, axis, cut, err);
   st = sph_domain_agree(&world, st, err);
@@ -1190,65 +1135,6 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
                                    double support, int dynamic,
                                    sph_error *err) {
   return share_create(out, ps, gidx, N, support, dynamic, NULL, 0, err);
-}
-
-/* rank 0's whole set: the creation fields of every rank's owned particles
- * at their storage indices (collective) */
-sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
-                                   sph_error *err) {
-  if (!d || d->all)
-    return SPH_OK;
-  static const sph_field fields[] = {SPH_FIELD_POSITION0, SPH_FIELD_VOLUME0,
-                                     SPH_FIELD_VELOCITY};
-  size_t N = d->rank == 0 ? (size_t)d->all_off[d->size] : 0;
-  sph_particles *all = NULL;
-  sph_status st = SPH_OK;
-  if (d->rank == 0) {
-    st = sph_particles_create(&all, N, d->dim, err);
-    if (st == SPH_OK)
-      st = sph_particles_require(all, SPH_FIELD_VELOCITY, err);
-    if (st == SPH_OK && !(all->slot = malloc((N ? N : 1) * sizeof *all->slot)))
-      st = sph_error_set(err, SPH_ERR_NOMEM, "whole set (%zu)", N);
-  }
-  st = sph_domain_agree(d, st, err);
-  if (st != SPH_OK) {
-    sph_particles_destroy(all);
-    return st;
-  }
-  const int64_t *at = d->all_gidx;
-  int n = (int)d->n;
-  for (size_t k = 0; k < sizeof fields / sizeof *fields; ++k) {
-    int nc = sph_field_components(fields[k]);
-    if (d->rank == 0)
-      for (int q = 0; q < d->size; ++q) {
-        d->counts[q] = nc * d->all_count[q];
-        d->offs[q] = nc * d->all_off[q];
-      }
-    MPI_Gatherv(ps->field[fields[k]], nc * n, MPI_DOUBLE, d->gbuf, d->counts,
-                d->offs, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-    for (size_t j = 0; d->rank == 0 && j < N; ++j)
-      memcpy(all->field[fields[k]] + (size_t)nc * (size_t)at[j],
-             d->gbuf + (size_t)nc * j, (size_t)nc * sizeof(double));
-  }
-  MPI_Gatherv(ps->id, n, MPI_INT64_T, d->gbuf, d->all_count, d->all_off,
-              MPI_INT64_T, 0, MPI_COMM_WORLD);
-  for (size_t j = 0; d->rank == 0 && j < N; ++j)
-    memcpy(all->id + at[j], (const int64_t *)d->gbuf + j, sizeof *all->id);
-  MPI_Gatherv(ps->body, n, MPI_INT32_T, d->gbuf, d->all_count, d->all_off,
-              MPI_INT32_T, 0, MPI_COMM_WORLD);
-  for (size_t j = 0; d->rank == 0 && j < N; ++j)
-    all->body[at[j]] = ((const int32_t *)d->gbuf)[j];
-  MPI_Gatherv(ps->flags, n, MPI_UINT32_T, d->gbuf, d->all_count, d->all_off,
-              MPI_UINT32_T, 0, MPI_COMM_WORLD);
-  for (size_t j = 0; d->rank == 0 && j < N; ++j)
-    all->flags[at[j]] = ((const uint32_t *)d->gbuf)[j];
-  if (d->rank == 0) {
-    all->n = N;
-    for (size_t i = 0; i < N; ++i)
-      all->slot[all->id[i]] = (int64_t)i;
-    d->all = all;
-  }
-  return SPH_OK;
 }
 
 sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
@@ -1403,54 +1289,6 @@ sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   if (err)
     *err = e;
   return e.code != SPH_OK ? e.code : SPH_ERR_IO;
-}
-
-void sph_domain_gather_select(sph_domain *d, unsigned long fields) {
-  if (d)
-    d->gathered = fields;
-}
-
-sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
-                             sph_error *err) {
-  if (!d)
-    return SPH_OK;
-  sph_status st = SPH_OK;
-  sph_particles *all = d->all;
-  double t0 = MPI_Wtime();
-  if (d->dyn) /* the owned sets change at every migration */
-    sph_domain_gather_map(d);
-  for (int f = 0; f < SPH_FIELD_COUNT; ++f) {
-    /* the reference positions and volumes never change */
-    if (!local->field[f] || f == SPH_FIELD_POSITION0 ||
-        f == SPH_FIELD_VOLUME0 || !(d->gathered & 1ul << f))
-      continue;
-    int nc = sph_field_components((sph_field)f);
-    if (d->rank == 0) {
-      for (int q = 0; q < d->size; ++q) {
-        d->counts[q] = nc * d->all_count[q];
-        d->offs[q] = nc * d->all_off[q];
-      }
-      if (st == SPH_OK)
-        st = sph_particles_require(all, (sph_field)f, err);
-    }
-    MPI_Gatherv(local->field[f], nc * (int)local->n, MPI_DOUBLE, d->gbuf,
-                d->counts, d->offs, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-    if (d->rank == 0 && st == SPH_OK) {
-      size_t N = all->n, w = (size_t)nc;
-      for (size_t k = 0; k < N; ++k)
-        memcpy(all->field[f] + w * (size_t)d->all_gidx[k], d->gbuf + w * k,
-               w * sizeof(double));
-    }
-  }
-  MPI_Gatherv(local->flags, (int)local->n, MPI_UINT32_T, d->gbuf, d->all_count,
-              d->all_off, MPI_UINT32_T, 0, MPI_COMM_WORLD);
-  if (d->rank == 0) {
-    const uint32_t *fl = (const uint32_t *)d->gbuf;
-    for (size_t k = 0; k < all->n; ++k)
-      all->flags[d->all_gidx[k]] = fl[k];
-  }
-  d->seconds += MPI_Wtime() - t0;
-  return sph_domain_agree(d, st, err);
 }
 
 sph_status sph_domain_box_points(sph_domain *d, const double *pts, size_t n,
@@ -1688,12 +1526,6 @@ sph_status sph_domain_create_share(sph_domain **out, sph_particles **ps,
   return sph_domain_create(out, ps, support, err);
 }
 
-sph_status sph_domain_whole_create(sph_domain *d, const sph_particles *ps,
-                                   sph_error *err) {
-  (void)d, (void)ps, (void)err;
-  return SPH_OK;
-}
-
 sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
   (void)err;
   return st;
@@ -1729,14 +1561,6 @@ void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
 sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
   (void)d, (void)err;
   return st;
-}
-sph_status sph_domain_gather(sph_domain *d, const sph_particles *local,
-                             sph_error *err) {
-  (void)d, (void)local, (void)err;
-  return SPH_OK;
-}
-void sph_domain_gather_select(sph_domain *d, unsigned long fields) {
-  (void)d, (void)fields;
 }
 sph_status sph_domain_box_points(sph_domain *d, const double *pts, size_t n,
                                  int ncomp, double radius, double **out,

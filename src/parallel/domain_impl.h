@@ -11,32 +11,26 @@ typedef struct sph_domain_dyn sph_domain_dyn;
 
 struct sph_domain {
   int rank, size, dim;
-  size_t n;           /* owned */
-  size_t ng;          /* ghosts */
-  size_t base;        /* first ghost point of exchanged arrays (0: n) */
-  int64_t *gidx;      /* storage index in the whole set: owned, then ghosts */
-  double *gX, *gV;    /* ghosts' reference positions and volumes */
-  int32_t *gbody;     /* ghosts' bodies */
-  int64_t *gid;       /* ghosts' particle ids */
-  int *recv_count;    /* ghosts owned by each rank */
-  int *recv_off;      /* their first ghost */
-  int *send_count;    /* owned particles each rank holds as ghosts */
-  int *send_off;      /* their first entry of send_idx */
-  int32_t *send_idx;  /* owned indices to send, grouped by rank */
-  size_t nsend;       /* entries of send_idx */
-  double *buf;        /* packed sends, 9 per entry (dynamic: wider) */
-  void *req;          /* 2 size requests */
-  sph_particles *all; /* rank 0: the whole set */
-  int *all_count, *all_off; /* rank 0: owned per rank (doubles: scaled) */
-  int64_t *all_gidx;        /* rank 0: storage indices, in rank order */
-  double *gbuf;             /* rank 0: 9 per particle, gathered */
-  int *counts, *offs;       /* rank 0: per-gather counts and offsets */
-  unsigned long gathered;   /* fields gathered to rank 0 (bit 1ul << f) */
-  double seconds;           /* in exchanges, reductions and gathers */
-  double sent, messages;    /* doubles and messages the exchanges sent */
-  double *sums;             /* 16 per rank: sph_domain_sum's gather */
-  size_t total;             /* particles of the whole run */
-  double *pbuf;             /* sph_domain_box_points' packed sends */
+  size_t n;          /* owned */
+  size_t ng;         /* ghosts */
+  size_t base;       /* first ghost point of exchanged arrays (0: n) */
+  int64_t *gidx;     /* storage index in the whole set: owned, then ghosts */
+  double *gX, *gV;   /* ghosts' reference positions and volumes */
+  int32_t *gbody;    /* ghosts' bodies */
+  int64_t *gid;      /* ghosts' particle ids */
+  int *recv_count;   /* ghosts owned by each rank */
+  int *recv_off;     /* their first ghost */
+  int *send_count;   /* owned particles each rank holds as ghosts */
+  int *send_off;     /* their first entry of send_idx */
+  int32_t *send_idx; /* owned indices to send, grouped by rank */
+  size_t nsend;      /* entries of send_idx */
+  double *buf;       /* packed sends, 9 per entry (dynamic: wider) */
+  void *req;         /* 2 size requests */
+  double seconds;    /* in exchanges, reductions and gathers */
+  double sent, messages; /* doubles and messages the exchanges sent */
+  double *sums;          /* 16 per rank: sph_domain_sum's gather */
+  size_t total;          /* particles of the whole run */
+  double *pbuf;          /* sph_domain_box_points' packed sends */
   size_t pbuf_cap;
   sph_domain_dyn *dyn; /* updated-Lagrangian runs, else NULL */
 };
@@ -81,7 +75,5 @@ size_t sph_domain_dyn_capacity(size_t N, int R);
 sph_status sph_domain_dyn_create(sph_domain *d, size_t N, const int *axis,
                                  const double *cut, sph_error *err);
 void sph_domain_dyn_destroy(sph_domain_dyn *y);
-/* rank 0: refreshes the gather's map after a migration (collective) */
-void sph_domain_gather_map(sph_domain *d);
 
 #endif

@@ -210,11 +210,6 @@ static sph_status check_distributed_terms(const sph_sim *sim, sph_error *err) {
   return SPH_OK;
 }
 
-int sph_sim_needs_whole_view(const sph_scene *s) {
-  (void)s; /* frames: sph/composite.h; references: reference.c */
-  return 0;
-}
-
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err) {
   *out = NULL;
@@ -275,11 +270,6 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   if (st == SPH_OK && sph_domain_world_size() > 1)
     st = distribute(sim, gidx, N, err);
   free(gidx);
-  /* rank 0's whole set, only for the outputs that read one */
-  if (st == SPH_OK && sph_sim_needs_whole_view(scene))
-    st = sph_domain_whole_create(sim->domain, sim->ps, err);
-  else if (st == SPH_OK)
-    sph_domain_drop_global(sim->domain);
   if (st == SPH_OK && sim->reference)
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)
