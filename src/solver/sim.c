@@ -184,17 +184,14 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
 
 /* Whether each rank can build its own share of the particles without the
  * whole set (sph_scene_build_share): no symmetry planes (their mirror
- * ghosts and images come from the whole set), bodies of lattice or jitter
- * points (a relaxation moves the whole body). */
+ * ghosts and images come from the whole set); a relaxation is made per
+ * rank, each rank moving its slice of the body's points. */
 static int per_rank_setup(const sph_scene *s, const sph_method_ops *method) {
   if (sph_domain_world_size() < 2 || !method->distributed)
     return 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     if (s->boundaries[k].kind == SPH_BC_SYMMETRY ||
         s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY)
-      return 0;
-  for (size_t b = 0; b < s->nbodies; ++b)
-    if (s->bodies[b].distribution == SPH_DIST_RELAX)
       return 0;
   return 1;
 }
