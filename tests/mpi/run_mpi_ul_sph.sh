@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # ul-sph over MPI ranks (mpirun, oversubscribed on the machine's cores): the
 # colliding rings as shipped, to 0.004 s (the rings touch at about 0.003 s),
-# on 2, 3 and 4 ranks give the serial run's files (check_mpi.py: the .pvtp
+# their `relax` particles relaxed per rank (each rank its slice of each
+# ring, with the other ranks' points as ghosts), on 2, 3 and 4 ranks give
+# the serial run's files (check_mpi.py: the .pvtp
 # series read by VTK with the serial particles and arrays, fields and frames
 # identical, energies to 1e-12 relative: sums over ranks in another order);
 # the 3-rank cut crosses the left ring, so particles migrate and the ranks
