@@ -275,9 +275,9 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
  * body is relaxed over MPI's ranks, each its slice of the creation order,
  * and streamed to every rank in each pass (sph_body_visit_share: then
  * collective over the ranks, whatever rank and size). *out is NULL (and
- * SPH_OK) when the cell grid would be larger than 2 cells a particle and 2^22 cells
- * (far apart bodies), or for several bodies when its cells are smaller
- * than half the spacing or clamped (sph_morton_cell). */
+ * SPH_OK) when the cell grid would be larger than 2 cells a particle and
+ * 2^22 cells (far apart bodies), or for several bodies when its cells are
+ * smaller than half the spacing or clamped (sph_morton_cell). */
 sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
                                  int size, sph_particles **out, int64_t **gidx,
                                  size_t *total, int64_t *overlap,
