@@ -523,9 +523,8 @@ static sph_status relax(const sph_body *b, int dim, pointset *p,
 
 /* ---- relaxation per MPI rank --------------------------------------------- */
 
-/* The cell grid sph_neighbors_build lays over the N points of the body (the
- * bounds reduced over the ranks): cells of at least the radius, grown by
- * 1.5 while they exceed 8 per point and 64 (neighbors.c). */
+/* The cell grid sph_neighbors_build lays over the N points of the body
+ * (sph_neighbors_grid, the bounds reduced over the ranks). */
 typedef struct slice_grid {
   double lo[3], cell;
   long nc[3];
@@ -551,21 +550,8 @@ static sph_status slice_grid_setup(slice_grid *g, const double *x, size_t n,
       return sph_error_set(err, SPH_ERR_NUMERIC,
                            "neighbour search: particle positions are not "
                            "finite or span more than a double can hold");
-  double cell = radius, limit = (double)(8 * N + 64), count[3];
-  for (;;) {
-    double total = 1.0;
-    for (int c = 0; c < 3; ++c) {
-      count[c] = c < dim ? floor((hi[c] - lo[c]) / cell) + 1.0 : 1.0;
-      total *= count[c];
-    }
-    if (total <= limit)
-      break;
-    cell *= 1.5;
-  }
-  for (int c = 0; c < 3; ++c)
-    g->nc[c] = (long)count[c];
+  g->cell = sph_neighbors_grid(lo, hi, N, dim, radius, g->nc);
   memcpy(g->lo, lo, sizeof lo);
-  g->cell = cell;
   return SPH_OK;
 }
 
