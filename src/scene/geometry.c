@@ -10,7 +10,9 @@
  *     (particle shifting in the manner of Lind et al. 2012, without flow),
  *     with the kernel support cut by a face replaced by the plane integral
  *     of W (exact for a plane, since grad C over a half-space is the
- *     integral of W over its boundary), and kept dp/2 inside the faces. */
+ *     integral of W over its boundary), and kept dp/2 inside the faces;
+ *     over MPI ranks each rank relaxes a slice of the points, with the
+ *     serial neighbour lists and sums (issue 20). */
 #include "sph/geometry.h"
 
 #include <math.h>
@@ -620,8 +622,8 @@ static size_t slice_scan(const slice_lists *L, const double *x,
           }
           if (b == a || d2 >= r2)
             continue;
-          if (out) /* in creation order: insertion by id */
-          {
+          /* in creation order: inserted by creation index */
+          if (out) {
             size_t q = k;
             for (; q > 0 && id[out[q - 1]] > id[b]; --q)
               out[q] = out[q - 1];
