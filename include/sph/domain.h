@@ -29,12 +29,12 @@ int sph_domain_world_rank(void);
 int sph_domain_world_size(void);
 
 /* Partitions *ps (every particle, the same on every rank, in storage
- * order) over the ranks: *ps becomes this rank's owned particles in the
- * same relative order (no rank keeps the whole set). Ghosts are the
- * particles of the
- * same body within `support` of an owned one (strictly, as
- * sph_neighbors_build). Refuses a rank count for which a rank would hold more
- * ghosts than owned particles. */
+ * order) over the ranks (the whole-set twin the per-rank set-up below is
+ * tested against; runs use sph_domain_create_share): *ps becomes this rank's
+ * owned particles in the same relative order (no rank keeps the whole set).
+ * Ghosts are the particles of the same body within `support` of an owned one
+ * (strictly, as sph_neighbors_build). Refuses a rank count for which a rank
+ * would hold more ghosts than owned particles. */
 sph_status sph_domain_create(sph_domain **out, sph_particles **ps,
                              double support, sph_error *err);
 void sph_domain_destroy(sph_domain *d);

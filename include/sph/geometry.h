@@ -37,4 +37,18 @@ sph_status sph_body_visit(const sph_body *b, int dim, sph_point_fn fn,
 sph_status sph_body_generate(const sph_body *b, int dim, double **x,
                              double **volume, size_t *n, sph_error *err);
 
+/* Over MPI ranks (collective): sph_body_visit of a lattice or jitter body,
+ * and for a `relax` body every particle as sph_body_generate makes it (the
+ * relaxed points, bit for bit, with their equal volumes) in creation order,
+ * the relaxation made per rank: on the first call each rank relaxes the
+ * slice [N r / R, N (r + 1) / R) of the N points into *slice (NULL before;
+ * kept for later calls, sph_body_slice_destroy after), with the other
+ * ranks' points within reach as ghosts; each call streams every rank's
+ * slice in rank order. */
+typedef struct sph_body_slice sph_body_slice;
+sph_status sph_body_visit_share(const sph_body *b, int dim,
+                                sph_body_slice **slice, sph_point_fn fn,
+                                void *ctx, size_t *n, sph_error *err);
+void sph_body_slice_destroy(sph_body_slice *s);
+
 #endif

@@ -45,6 +45,13 @@ sph_status sph_neighbors_build(sph_neighbors *nl, const double *x, size_t n,
                                int dim, double radius, const int32_t *body,
                                sph_pair_filter filter, sph_error *err);
 
+/* The cell grid sph_neighbors_build lays over n points whose coordinates
+ * c < dim span [lo[c], hi[c]]: cells of at least `radius` (grown while
+ * there would be more than 8 a point and 64), nc[c] of them along axis c
+ * from lo; returns the cell size. */
+double sph_neighbors_grid(const double lo[3], const double hi[3], size_t n,
+                          int dim, double radius, long nc[3]);
+
 /* Reference O(N^2) search with the same contract (tests, debug checks). */
 sph_status sph_neighbors_build_brute(sph_neighbors *nl, const double *x,
                                      size_t n, int dim, double radius,

@@ -271,11 +271,13 @@ sph_status sph_scene_build_particles(const sph_scene *s, sph_particles **out,
  * found among the share's particles and those of the cells next to them:
  * that error is this rank's alone, *overlap the creation index of its
  * first particle (the lowest over the ranks is the whole set's error;
- * INT64_MAX for every other outcome, the same on every rank). Lattice and
- * jitter distributions only (not `relax`). *out is NULL (and SPH_OK) when
- * the cell grid would be larger than 2 cells a particle and 2^22 cells
- * (far apart bodies), or for several bodies when its cells are smaller
- * than half the spacing or clamped (sph_morton_cell). */
+ * INT64_MAX for every other outcome, the same on every rank). A `relax`
+ * body is relaxed over MPI's ranks, each its slice of the creation order,
+ * and streamed to every rank in each pass (sph_body_visit_share: then
+ * collective over the ranks, whatever rank and size). *out is NULL (and
+ * SPH_OK) when the cell grid would be larger than 2 cells a particle and
+ * 2^22 cells (far apart bodies), or for several bodies when its cells are
+ * smaller than half the spacing or clamped (sph_morton_cell). */
 sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
                                  int size, sph_particles **out, int64_t **gidx,
                                  size_t *total, int64_t *overlap,

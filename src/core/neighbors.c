@@ -142,6 +142,27 @@ sph_status sph_neighbors_build_brute(sph_neighbors *nl, const double *x,
   return SPH_OK;
 }
 
+double sph_neighbors_grid(const double lo[3], const double hi[3], size_t n,
+                          int dim, double radius, long nc[3]) {
+  /* cell counts in double first: a span of 1e19 m over a 1 mm cell does
+   * not fit a long */
+  double cell = radius, limit = (double)(CELLS_PER_PARTICLE_MAX * n + 64);
+  double count[3];
+  for (;;) {
+    double total = 1.0;
+    for (int c = 0; c < 3; ++c) {
+      count[c] = c < dim ? floor((hi[c] - lo[c]) / cell) + 1.0 : 1.0;
+      total *= count[c];
+    }
+    if (total <= limit)
+      break;
+    cell *= 1.5;
+  }
+  for (int c = 0; c < 3; ++c)
+    nc[c] = (long)count[c];
+  return cell;
+}
+
 /* Grid over the bounding box; cell size >= radius. */
 typedef struct grid {
   double lo[3];
@@ -167,24 +188,8 @@ static sph_status grid_setup(grid *g, const double *x, size_t n, int dim,
       return sph_error_set(err, SPH_ERR_NUMERIC,
                            "neighbour search: particle positions are not "
                            "finite or span more than a double can hold");
-  /* cell counts in double first: a span of 1e19 m over a 1 mm cell does
-   * not fit a long */
-  double cell = radius, limit = (double)(CELLS_PER_PARTICLE_MAX * n + 64);
-  double count[3];
-  for (;;) {
-    double total = 1.0;
-    for (int c = 0; c < 3; ++c) {
-      count[c] = c < dim ? floor((hi[c] - lo[c]) / cell) + 1.0 : 1.0;
-      total *= count[c];
-    }
-    if (total <= limit)
-      break;
-    cell *= 1.5;
-  }
-  for (int c = 0; c < 3; ++c)
-    g->nc[c] = (long)count[c];
+  g->cell = sph_neighbors_grid(lo, hi, n, dim, radius, g->nc);
   memcpy(g->lo, lo, sizeof lo);
-  g->cell = cell;
   return SPH_OK;
 }
 

@@ -1726,6 +1726,7 @@ typedef struct share_pass {
   int64_t *nid;
   char *nin; /* in the share */
   size_t nn, ncap;
+  sph_body_slice **slices; /* per body: a relax body's slice on this rank */
 } share_pass;
 
 /* whether a cell next to q (or q) holds a particle of the share */
@@ -1827,8 +1828,9 @@ static sph_status share_visit(share_pass *p, int pass, sph_error *err) {
   p->id = 0;
   for (p->b = 0; p->b < p->s->nbodies; ++p->b) {
     size_t n;
-    sph_status st = sph_body_visit(&p->s->bodies[p->b], p->s->dimension,
-                                   share_point, p, &n, err);
+    sph_status st =
+        sph_body_visit_share(&p->s->bodies[p->b], p->s->dimension,
+                             &p->slices[p->b], share_point, p, &n, err);
     if (st != SPH_OK)
       return body_error(p->s, p->b, st, err);
   }
@@ -1865,19 +1867,21 @@ static sph_status share_starts(share_pass *p, size_t cells, sph_error *err) {
   return SPH_OK;
 }
 
-sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
-                                 int size, sph_particles **out, int64_t **gidx,
-                                 size_t *total, int64_t *overlap,
-                                 sph_error *err) {
+static sph_status build_share(const sph_scene *s, double cell, int rank,
+                              int size, sph_particles **out, int64_t **gidx,
+                              size_t *total, int64_t *overlap,
+                              sph_body_slice **slices, sph_error *err) {
   *out = NULL;
   *gidx = NULL;
   *total = 0;
   *overlap = INT64_MAX;
   share_pass p = {.s = s,
                   .cell = cell,
+                  .slices = slices,
                   .lo = {INFINITY, INFINITY, INFINITY},
                   .hi = {-INFINITY, -INFINITY, -INFINITY}};
-  /* pass 1: the bounds and the checks, as the whole set's */
+  /* pass 1: the bounds and the checks, as the whole set's (relax bodies
+   * relaxed per rank on their first visit) */
   sph_status st = checks_create(s, &p.c, err);
   if (st == SPH_OK)
     st = share_visit(&p, 1, err);
@@ -1957,4 +1961,19 @@ sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
   *gidx = p.gidx;
   *total = N;
   return SPH_OK;
+}
+
+sph_status sph_scene_build_share(const sph_scene *s, double cell, int rank,
+                                 int size, sph_particles **out, int64_t **gidx,
+                                 size_t *total, int64_t *overlap,
+                                 sph_error *err) {
+  sph_body_slice **slices = calloc(s->nbodies + 1, sizeof *slices);
+  if (!slices)
+    return sph_error_set(err, SPH_ERR_NOMEM, "bodies");
+  sph_status st =
+      build_share(s, cell, rank, size, out, gidx, total, overlap, slices, err);
+  for (size_t b = 0; b < s->nbodies; ++b)
+    sph_body_slice_destroy(slices[b]);
+  free(slices);
+  return st;
 }

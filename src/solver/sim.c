@@ -126,7 +126,7 @@ static sph_status check_memory(const sph_scene *scene, double support,
 
 /* A distributed run (more than one MPI rank) of what runs distributed so
  * far: refused, the same on every rank, before anything is written; from
- * each rank's share (gidx: its storage indices, of N) or the whole set. */
+ * each rank's share (gidx: its storage indices, of N). */
 static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
                              sph_error *err) {
   const sph_scene *s = sim->scene;
@@ -164,39 +164,26 @@ static sph_status distribute(sph_sim *sim, const int64_t *gidx, size_t N,
   /* updated Lagrangian: ghosts within three supports of the box and its
    * reflections, as an image's stabilised force matrix reads its
    * neighbours' corrections (methods/ul_csph) */
-  if (np && sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC) {
-    SPH_TRY(gidx ? sph_domain_create_share(&sim->domain, &sim->ps, gidx, N,
-                                           sim->kernel.support, 1, err)
-                 : sph_domain_create_dynamic(&sim->domain, &sim->ps,
-                                             sim->kernel.support, err));
+  int dynamic = sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC;
+  if (np && dynamic) {
+    SPH_TRY(sph_domain_create_share(&sim->domain, &sim->ps, gidx, N,
+                                    sim->kernel.support, 1, err));
     return sph_domain_dyn_mirror(sim->domain, planes, np, 3.0, err);
   }
-  if (gidx && np)
+  if (np)
     return sph_domain_create_share_mirrored(
         &sim->domain, &sim->ps, gidx, N, sim->kernel.support, planes, np, err);
-  if (gidx)
-    return sph_domain_create_share(
-        &sim->domain, &sim->ps, gidx, N, sim->kernel.support,
-        sim->method->distributed == SPH_DISTRIBUTED_DYNAMIC, err);
-  if (np)
-    return sph_domain_create_mirrored(&sim->domain, &sim->ps,
-                                      sim->kernel.support, planes, np, err);
-  if (sim->method->distributed != SPH_DISTRIBUTED_DYNAMIC)
-    return sph_domain_create(&sim->domain, &sim->ps, sim->kernel.support, err);
-  return sph_domain_create_dynamic(&sim->domain, &sim->ps, sim->kernel.support,
-                                   err);
+  return sph_domain_create_share(&sim->domain, &sim->ps, gidx, N,
+                                 sim->kernel.support, dynamic, err);
 }
 
 /* Whether each rank can build its own share of the particles without the
- * whole set (sph_scene_build_share): bodies of lattice or jitter points (a
- * relaxation moves the whole body). */
-static int per_rank_setup(const sph_scene *s, const sph_method_ops *method) {
-  if (sph_domain_world_size() < 2 || !method->distributed)
-    return 0;
-  for (size_t b = 0; b < s->nbodies; ++b)
-    if (s->bodies[b].distribution == SPH_DIST_RELAX)
-      return 0;
-  return 1;
+ * whole set (sph_scene_build_share): every distributed method, symmetry
+ * planes included (their mirror ghosts come from the other ranks' reflected
+ * boxes); a relaxation is made per rank, each rank moving its slice of the
+ * body's points. */
+static int per_rank_setup(const sph_method_ops *method) {
+  return sph_domain_world_size() > 1 && method->distributed;
 }
 
 /* Every term a distributed method creates must run on owned particles. */
@@ -251,7 +238,7 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   /* over MPI ranks: this rank's share of the particles, in the order below */
   int64_t *gidx = NULL, first = INT64_MAX;
   size_t N = 0;
-  if (st == SPH_OK && per_rank_setup(scene, method))
+  if (st == SPH_OK && per_rank_setup(method))
     st = sph_scene_build_share(scene, sim->kernel.support,
                                sph_domain_world_rank(), sph_domain_world_size(),
                                &sim->ps, &gidx, &N, &first, err);

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # ul-sph over MPI ranks (mpirun, oversubscribed on the machine's cores): the
 # colliding rings as shipped, to 0.004 s (the rings touch at about 0.003 s),
-# on 2, 3 and 4 ranks give the serial run's files (check_mpi.py: the .pvtp
+# their `relax` particles relaxed per rank (each rank its slice of each
+# ring, with the other ranks' points as ghosts), on 2, 3 and 4 ranks give
+# the serial run's files (check_mpi.py: the .pvtp
 # series read by VTK with the serial particles and arrays, fields and frames
 # identical, energies to 1e-12 relative: sums over ranks in another order);
 # the 3-rank cut crosses the left ring, so particles migrate and the ranks
 # re-balance (summary.json counts them); the same rank count twice writes
-# the same bytes; the stretched plate with its clamped base on 2 and 4 ranks
+# the same bytes; a relaxed ball on a plate on 2 and 3 ranks equals its
+# serial run; the stretched plate with its clamped base on 2 and 4 ranks
 # equals its serial run too, and on 4 ranks resumes from its checkpoint to
 # the same bytes. Usage: run_mpi_ul_sph.sh SPH SOURCE_DIR
 set -u
@@ -40,6 +43,13 @@ cat "$work/out.txt"
 # the same rank count and thread count: the same bytes
 check "np 3 again" "${mpi[@]}" -np 3 "$sph" "${run[@]}" --out "$work/np3b"
 check "np 3 twice: identical files" same_bytes "$work/np3" "$work/np3b"
+
+# a relaxed ball on a lattice plate with clamped ends (relax and lattice
+# bodies and selections in one per-rank set-up) on 2 and 3 ranks
+ball=(run ball_plate_2d --quiet --set time.end=0.0003 --set output.every=0.0001
+  --set output.png=false
+  --set 'output.fields=[velocity,pressure,von_mises,density,particle_id]')
+compare ball ball_plate_2d 1e-12 2 3 -- "${ball[@]}"
 
 # a clamped base whose particles migrate (the boundary's particle sets
 # follow them): the stretched plate on 2 and 4 ranks

@@ -5,11 +5,13 @@
  * indices, ghosts (positions, volumes, bodies, ids, in the same order) and
  * halo plan; the same for the updated-Lagrangian (dynamic) domain. 3D face
  * lattice with jitter (a turned column), 2D cells with jitter, two 3D bodies (a
- * block and a punch). With symmetry and skew-symmetry planes
- * (sph_domain_create_share_mirrored against sph_domain_create_mirrored,
- * the ghosts of the planes' images included): the swinging cube's six
- * coordinate planes, the punch's two (also dynamic), a turned plate's
- * oblique ones. Run under mpirun (ctest: 2, 3 and 4 ranks). */
+ * block and a punch), relaxed bodies (a 2D ring; a turned 3D ball and a
+ * plate), each rank relaxing its slice. With symmetry and skew-symmetry
+ * planes (sph_domain_create_share_mirrored against
+ * sph_domain_create_mirrored, the ghosts of the planes' images included):
+ * the swinging cube's six coordinate planes, the punch's two (also
+ * dynamic), a turned plate's oblique ones. Run under mpirun (ctest: 2, 3
+ * and 4 ranks). */
 #include "parallel/domain_impl.h"
 
 #include <check.h>
@@ -257,6 +259,41 @@ START_TEST(oblique_2d) {
 }
 END_TEST
 
+/* relaxed bodies: each rank relaxes its slice of each body, with the
+ * other ranks' points as ghosts; a 2D ring and a turned 3D ball */
+START_TEST(relax_ring_2d) {
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      2) "  - name: ring\n"
+         "    material: m\n"
+         "    shape: {ring: {center: [-0.045, 0.01], inner_radius: 0.03, "
+         "outer_radius: 0.04}}\n"
+         "    particles: {spacing: 0.0015, distribution: relax, seed: 1}\n"
+         "    initial_velocity: {uniform: [7, 0, 0]}\n";
+  ck_assert_int_eq(differences(scene, 2.6 * 0.0015, 0), 0);
+  ck_assert_int_eq(differences(scene, 2.6 * 0.0015, 1), 0);
+}
+END_TEST
+
+START_TEST(relax_ball_3d) {
+  const char *scene = SPH_TEST_SCENE_HEAD(
+      3) "  - name: ball\n"
+         "    material: m\n"
+         "    shape: {shell: {center: [0.045, 0, 0], inner_radius: 0.02, "
+         "outer_radius: 0.04}}\n"
+         "    particles: {spacing: 0.005, distribution: relax, seed: 2}\n"
+         "    transform: {rotate: {axis: [0, 1, 1], angle: 25}}\n"
+         "    initial_velocity: {uniform: [-9, 0, 0]}\n"
+         "  - name: plate\n"
+         "    material: m\n"
+         "    shape: {box: {min: [-0.05, -0.05, -0.05], max: [-0.01, 0.05, "
+         "0.05]}}\n"
+         "    particles: {spacing: 0.005, distribution: relax, seed: 3, "
+         "relax_steps: 30}\n";
+  ck_assert_int_eq(differences(scene, 2.6 * 0.005, 0), 0);
+  ck_assert_int_eq(differences(scene, 2.6 * 0.005, 1), 0);
+}
+END_TEST
+
 int main(int argc, char **argv) {
   sph_error err;
   if (sph_domain_init(&argc, &argv, &err) != SPH_OK)
@@ -270,6 +307,8 @@ int main(int argc, char **argv) {
   tcase_add_test(t, swinging_cube);
   tcase_add_test(t, punch_2d);
   tcase_add_test(t, oblique_2d);
+  tcase_add_test(t, relax_ring_2d);
+  tcase_add_test(t, relax_ball_3d);
   suite_add_tcase(s, t);
   return sph_mpi_check_run(s);
 }

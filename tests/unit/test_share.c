@@ -3,8 +3,8 @@
  * whole set's after sph_particles_sort_morton at their storage indices, bit
  * for bit, and the shares cover the storage indices once (2D and 3D, face
  * and cell lattices, jitter, several bodies with transforms and initial
- * velocities, a grid beyond the Morton order's 2^21 clamp); bodies that
- * overlap give the whole set's error. */
+ * velocities, a grid beyond the Morton order's 2^21 clamp, relaxed
+ * bodies); bodies that overlap give the whole set's error. */
 #include "test_util.h"
 
 #include <stdint.h>
@@ -240,6 +240,31 @@ START_TEST(share_2d) {
 }
 END_TEST
 
+/* two relaxed rings (seed 002's colliding rings, coarser), the second
+ * turned */
+static const char *rings2 = SPH_TEST_SCENE_HEAD(
+    2) "  - name: left\n"
+       "    material: m\n"
+       "    shape: {ring: {center: [-0.045, 0], inner_radius: 0.03, "
+       "outer_radius: 0.04}}\n"
+       "    particles: {spacing: 0.002, distribution: relax, seed: 1}\n"
+       "    initial_velocity: {uniform: [7, 0, 0]}\n"
+       "  - name: right\n"
+       "    material: m\n"
+       "    shape: {ring: {center: [0, 0], inner_radius: 0.03, "
+       "outer_radius: 0.04}}\n"
+       "    particles: {spacing: 0.002, distribution: relax, seed: 2, "
+       "relax_steps: 40}\n"
+       "    transform: {rotate: {angle: 30}, translate: [0.045, 0]}\n";
+
+START_TEST(share_relax) {
+  /* one rank relaxes each body through its own lists (the serial lists'
+   * grid, stencil and order): the whole set's points */
+  for (int size = 1; size <= 3; ++size)
+    check_shares(rings2, 0.0052, size);
+}
+END_TEST
+
 START_TEST(share_clamp) {
   /* 3.0e6 cells across the bar: its last 900 particles share the last
    * cell, in creation order */
@@ -255,6 +280,7 @@ static Suite *suite(void) {
   tcase_add_test(t, share_2d);
   tcase_add_test(t, share_clamp);
   tcase_add_test(t, share_overlap);
+  tcase_add_test(t, share_relax);
   suite_add_tcase(s, t);
   return s;
 }
