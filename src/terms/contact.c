@@ -114,6 +114,17 @@ static sph_status ghosts_cover(const contact *ct, const double *x,
                        sqrt(d2max) / ct->radius, ct->slack / ct->radius);
 }
 
+/* e = xa - xb; returns |e|^2 */
+static inline double separation(const double *xa, const double *xb,
+                                double e[3]) {
+  double r2 = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    e[c] = xa[c] - xb[c];
+    r2 += e[c] * e[c];
+  }
+  return r2;
+}
+
 /* the spring of a pair at separation e (r2 = |e|^2) onto f: contact
  * distance half the sum of spacings, the moduli's harmonic mean, the mean
  * area */
@@ -228,11 +239,7 @@ static sph_status between_ranks(contact *ct, const sph_sim *sim,
     double f[3] = {0, 0, 0};
     for (size_t s = nl->offset[i]; s < nl->offset[i + 1]; ++s) {
       size_t j = (size_t)nl->index[s];
-      double e[3], r2 = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        e[c] = xc[3 * i + c] - xc[3 * j + c];
-        r2 += e[c] * e[c];
-      }
+      double e[3], r2 = separation(xc + 3 * i, xc + 3 * j, e);
       pair_force(kappa, e, r2, ct->sc[i] + ct->sc[j], ct->mc[i], ct->mc[j],
                  ct->ac[i] + ct->ac[j], f);
     }
@@ -282,11 +289,7 @@ static sph_status between_bodies(contact *ct, const sph_sim *sim,
     double f[3] = {0, 0, 0};
     for (size_t s = nl->offset[i]; s < nl->offset[i + 1]; ++s) {
       size_t b = (size_t)nl->index[s];
-      double e[3], r2 = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        e[c] = x[3 * a + c] - x[3 * b + c];
-        r2 += e[c] * e[c];
-      }
+      double e[3], r2 = separation(x + 3 * a, x + 3 * b, e);
       pair_force(kappa, e, r2, ct->spacing[a] + ct->spacing[b], ct->modulus[a],
                  ct->modulus[b], ct->area[a] + ct->area[b], f);
     }
