@@ -270,7 +270,7 @@ static void png_view(const sph_sim *sim, sph_view *v, double lo[3],
       lo[k] = fmin(lo[k], X[3 * a + k]);
       hi[k] = fmax(hi[k], X[3 * a + k]);
     }
-  sph_composite_minmax(sim->domain, lo, hi, 3); /* over the ranks */
+  sph_domain_minmax(sim->domain, lo, hi, 3); /* over the ranks */
   png_pad(sim->dp, lo, hi);
   if (!(c->given && c->has_position)) {
     png_fit(s, lo, hi, v);
@@ -981,7 +981,7 @@ static void png_replay(png_sink *p, const sph_sim *sim, const char *dir,
     double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
     png_box(xyz, m, lo, hi);
     lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
-    sph_composite_minmax(p->domain, lo, hi, 5);
+    sph_domain_minmax(p->domain, lo, hi, 5);
     if (grow)
       png_grow_range(p, lo[3], hi[3], hi[4]);
     if (p->follow)
@@ -1156,7 +1156,7 @@ static sph_status png_snapshot_ranks(png_sink *p, const sph_frame *fr,
   double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
   png_box(s->xyz, m, lo, hi);
   lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
-  sph_composite_minmax(p->domain, lo, hi, 5);
+  sph_domain_minmax(p->domain, lo, hi, 5);
   uint64_t all = nf;
   sph_composite_sum_u64(p->domain, &all, 1);
   if (p->follow)

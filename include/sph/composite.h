@@ -42,10 +42,6 @@ sph_status sph_composite_reduce(sph_domain *d, const sph_composite_px *px,
                                 size_t npix, sph_composite_px *out,
                                 sph_error *err);
 
-/* lo[i] becomes the least and hi[i] the greatest over the ranks, i < n
- * (n <= 16; collective, exact). */
-void sph_composite_minmax(sph_domain *d, double *lo, double *hi, int n);
-
 /* Sums of count unsigned integers over the ranks (collective, exact). */
 void sph_composite_sum_u64(sph_domain *d, uint64_t *v, int count);
 

@@ -124,6 +124,9 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
  * (the same bits for a fixed rank count). */
 double sph_domain_min(sph_domain *d, double v);
 double sph_domain_max(sph_domain *d, double v);
+/* lo[i] becomes the least and hi[i] the greatest over the ranks, i < n
+ * (collective, exact; one reduction for 16 pairs). */
+void sph_domain_minmax(sph_domain *d, double *lo, double *hi, int n);
 void sph_domain_sum(sph_domain *d, double *v, int count);
 /* The same for any count, chunk values at a time through work (the rank
  * count times chunk doubles). */

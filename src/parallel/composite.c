@@ -55,26 +55,6 @@ sph_status sph_composite_reduce(sph_domain *d, const sph_composite_px *px,
   return SPH_OK;
 }
 
-void sph_composite_minmax(sph_domain *d, double *lo, double *hi, int n) {
-#ifdef SPH_HAVE_MPI
-  if (d && n > 0 && n <= 16) {
-    double v[32], r[32];
-    for (int i = 0; i < n; ++i) {
-      v[i] = lo[i];
-      v[n + i] = -hi[i]; /* negation is exact: one MPI_MIN for both */
-    }
-    double t0 = MPI_Wtime();
-    MPI_Allreduce(v, r, 2 * n, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-    d->seconds += MPI_Wtime() - t0;
-    for (int i = 0; i < n; ++i) {
-      lo[i] = r[i];
-      hi[i] = -r[n + i];
-    }
-  }
-#endif
-  (void)d, (void)lo, (void)hi, (void)n;
-}
-
 void sph_composite_sum_u64(sph_domain *d, uint64_t *v, int count) {
 #ifdef SPH_HAVE_MPI
   if (d && count > 0) {

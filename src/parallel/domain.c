@@ -1224,6 +1224,26 @@ double sph_domain_max(sph_domain *d, double v) {
   return out;
 }
 
+void sph_domain_minmax(sph_domain *d, double *lo, double *hi, int n) {
+  if (!d)
+    return;
+  double t0 = MPI_Wtime();
+  for (int at = 0; at < n; at += 16) { /* 16 pairs a reduction */
+    int m = n - at < 16 ? n - at : 16;
+    double v[32], r[32];
+    for (int i = 0; i < m; ++i) {
+      v[i] = lo[at + i];
+      v[m + i] = -hi[at + i]; /* negation is exact: one MPI_MIN for both */
+    }
+    MPI_Allreduce(v, r, 2 * m, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    for (int i = 0; i < m; ++i) {
+      lo[at + i] = r[i];
+      hi[at + i] = -r[m + i];
+    }
+  }
+  d->seconds += MPI_Wtime() - t0;
+}
+
 void sph_domain_sum(sph_domain *d, double *v, int count) {
   if (!d || count <= 0 || count > 16)
     return;
@@ -1546,6 +1566,9 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
 
 double sph_domain_min(sph_domain *d, double v) { return (void)d, v; }
 double sph_domain_max(sph_domain *d, double v) { return (void)d, v; }
+void sph_domain_minmax(sph_domain *d, double *lo, double *hi, int n) {
+  (void)d, (void)lo, (void)hi, (void)n;
+}
 void sph_domain_sum(sph_domain *d, double *v, int count) {
   (void)d, (void)v, (void)count;
 }

@@ -156,9 +156,8 @@ static void body_boxes(contact *ct, const double *x, const int32_t *body,
       bx[c] = fmin(bx[c], x[3 * a + c]);
       bx[3 + c] = fmax(bx[3 + c], x[3 * a + c]);
     }
-  for (int k = 0; ct->ranks && k < 6 * ct->nbodies; ++k)
-    ct->box[k] = k % 6 < 3 ? sph_domain_min(ct->ranks, ct->box[k])
-                           : sph_domain_max(ct->ranks, ct->box[k]);
+  for (int b = 0; ct->ranks && b < ct->nbodies; ++b)
+    sph_domain_minmax(ct->ranks, ct->box + 6 * b, ct->box + 6 * b + 3, 3);
 }
 
 /* room for m candidates (grown only, amortised; each array stays as it

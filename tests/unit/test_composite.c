@@ -163,7 +163,7 @@ END_TEST
 
 START_TEST(reductions_without_domain) {
   double lo[2] = {1.0, -2.0}, hi[2] = {3.0, 4.0};
-  sph_composite_minmax(NULL, lo, hi, 2);
+  sph_domain_minmax(NULL, lo, hi, 2);
   ck_assert(lo[0] == 1.0 && lo[1] == -2.0 && hi[0] == 3.0 && hi[1] == 4.0);
   uint64_t c[2] = {5, 7};
   sph_composite_sum_u64(NULL, c, 2);
