@@ -20,8 +20,8 @@
 
 #include <stddef.h>
 
-#include "sph/composite.h"
-#include "sph/image.h"
+#include "parallel/composite.h"
+#include "render/image.h"
 #include "sph/status.h"
 
 /* Background grey of every frame, 0-255 per channel (alpha is 255). */

@@ -10,8 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/image.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "render/image.h"
 
 /* Fixed zlib level and row filter: the same pixels give the same bytes
  * (level 1: a third faster than 6 on rendered frames, 5 % larger files). */

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/image.h"
+#include "render/image.h"
 
 /* Mask values: a good pixel, a bad one, a bad one already in a cluster. */
 enum { SPH_IMGDIFF_GOOD = 0, SPH_IMGDIFF_BAD = 1, SPH_IMGDIFF_SEEN = 2 };

@@ -12,7 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "sph/render.h"
+#include "render/render.h"
 
 extern char **environ;
 

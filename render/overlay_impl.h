@@ -9,7 +9,7 @@
 
 #include "sph/status.h"
 
-#include "sph/image.h"
+#include "render/image.h"
 
 /* --- colour maps ------------------------------------------------------------
  */

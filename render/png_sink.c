@@ -48,13 +48,13 @@
 #include <sys/stat.h>
 
 #include "gl_impl.h"
+#include "io/vtk_read.h"
 #include "overlay_impl.h"
-#include "sph/composite.h"
-#include "sph/domain.h"
-#include "sph/geometry.h"
-#include "sph/image.h"
-#include "sph/render.h"
-#include "sph/vtk_read.h"
+#include "parallel/composite.h"
+#include "parallel/domain.h"
+#include "render/image.h"
+#include "render/render.h"
+#include "scene/geometry.h"
 
 /* One frame as the simulation thread hands it to the renderer. */
 typedef struct png_frame {

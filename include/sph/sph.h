@@ -16,11 +16,11 @@
 #ifndef SPH_SPH_H
 #define SPH_SPH_H
 
-#include "sph/particles.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/sink.h"
-#include "sph/stability.h"
+#include "core/particles.h"
+#include "io/sink.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
+#include "solver/stability.h"
 #include "sph/status.h"
 
 #endif

@@ -2,9 +2,9 @@
  * fuzz target (tests/fuzz): scene, overrides, memory estimate, particles,
  * method, png block; nothing printed, nothing simulated. */
 #include "app/app_impl.h"
-#include "sph/render.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 sph_status sph_app_check_scene(const char *path, const char *const *sets,
                                size_t nsets, double max_memory,

@@ -21,11 +21,11 @@
 #include <unistd.h>
 
 #include "app/app_impl.h"
-#include "sph/domain.h"
-#include "sph/render.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "parallel/domain.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 #define BENCH_SCHEMA 1
 #define BENCH_MAX_SETS 8

@@ -4,9 +4,9 @@
 #include <sys/resource.h>
 
 #include "app/app_impl.h"
-#include "sph/node.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
+#include "scene/node.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 static double peak_rss_mib(void) {
   struct rusage ru;

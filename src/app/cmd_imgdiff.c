@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "app/app_impl.h"
-#include "sph/image.h"
+#include "render/image.h"
 
 static const char *const imgdiff_usage =
     "usage: sph imgdiff A.png B.png [--tolerance N] [--shift N] "

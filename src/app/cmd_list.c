@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "app/app_impl.h"
-#include "sph/scene.h"
+#include "scene/scene.h"
 
 static int cmp_str(const void *a, const void *b) {
   return strcmp(*(char *const *)a, *(char *const *)b);

@@ -12,10 +12,10 @@
 #include <sys/stat.h>
 
 #include "app/app_impl.h"
-#include "sph/render.h"
-#include "sph/scene.h"
-#include "sph/sink.h"
-#include "sph/vtk_read.h"
+#include "io/sink.h"
+#include "io/vtk_read.h"
+#include "render/render.h"
+#include "scene/scene.h"
 
 static const char *const render_usage =
     "usage: sph render RUN_DIR|RUN_DIR/<scene>.pvd [--field F] "

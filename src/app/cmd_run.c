@@ -16,13 +16,13 @@
 
 #include "app/app_impl.h"
 #include "app/progress_impl.h"
-#include "sph/checkpoint.h"
-#include "sph/reference.h"
-#include "sph/render.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/sink.h"
-#include "sph/stability.h"
+#include "io/checkpoint.h"
+#include "io/sink.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "solver/reference.h"
+#include "solver/sim.h"
+#include "solver/stability.h"
 
 static int file_exists(const char *dir, const char *name) {
   char path[1200];

@@ -14,9 +14,9 @@
 
 #include "app/app_impl.h"
 #include "app/study_impl.h"
-#include "sph/node.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
+#include "scene/node.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 typedef struct study_args {
   const char *sets[SPH_MAX_SETS];

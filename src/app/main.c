@@ -10,11 +10,11 @@
 #include <unistd.h>
 
 #include "app/app_impl.h"
-#include "sph/domain.h"
-#include "sph/render.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/stability.h"
+#include "parallel/domain.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
+#include "solver/stability.h"
 
 static void usage(FILE *out) {
   fprintf(out,

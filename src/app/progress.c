@@ -3,7 +3,7 @@
 #include <unistd.h>
 
 #include "app/progress_impl.h"
-#include "sph/sim.h"
+#include "solver/sim.h"
 
 void sph_progress_start(sph_progress *p, double t_end, int quiet) {
   p->tty = isatty(fileno(stderr));

@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "app/study_impl.h"
-#include "sph/sink.h"
+#include "io/sink.h"
 
 const char *const study_norm_names[STUDY_NORMS] = {
     "l2_velocity", "l2_stress", "l2_displacement", "h1_displacement",

@@ -8,13 +8,13 @@
  *
  * The gradient of W~0 is the exact derivative of eq. 10,
  * (grad W_b - W_b gamma) / S; eq. 13 as printed drops the factor W_b. */
-#include "sph/corrections.h"
+#include "core/corrections.h"
 
 #include <float.h>
 #include <math.h>
 #include <string.h>
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 #define RCOND_DEFAULT 1e-10
 

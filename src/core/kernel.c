@@ -3,7 +3,7 @@
  * support 3h), Wendland C2 and C4 (Wendland 1995; Dehnen & Aly 2012,
  * support 2h, as SPHinXsys uses them, seed 002 sec. 6). In 1D the Wendland
  * functions of the matching smoothness for d = 1 are used. */
-#include "sph/kernel.h"
+#include "core/kernel.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,7 +1,7 @@
 /* Neighbour search: cell lists (cell size >= search radius) into compact CSR
  * lists, deterministic for any thread count (each particle's list is sorted
  * by index). DESIGN.md sec. 5. */
-#include "sph/neighbors.h"
+#include "core/neighbors.h"
 
 #include <math.h>
 #include <stdlib.h>

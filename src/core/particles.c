@@ -1,8 +1,8 @@
 /* Particle storage (structure of arrays, fields allocated on demand), the
  * mirror images of symmetry planes and the momentum sums. */
-#include "sph/particles.h"
+#include "core/particles.h"
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 #include <math.h>
 #include <omp.h>

@@ -10,7 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/sink.h"
+#include "io/sink.h"
 
 sph_status sph_atomic_open(sph_atomic_file *af, const char *path,
                            sph_error *err) {

@@ -13,11 +13,11 @@
 #include <string.h>
 #include <zlib.h>
 
-#include "sph/checkpoint.h"
-#include "sph/domain.h"
-#include "sph/node.h"
-#include "sph/reference.h"
-#include "sph/sink.h"
+#include "io/checkpoint.h"
+#include "io/sink.h"
+#include "parallel/domain.h"
+#include "scene/node.h"
+#include "solver/reference.h"
 
 static const char magic[8] = "SPHCKPT";
 static const uint32_t endian_tag = 0x01020304u;

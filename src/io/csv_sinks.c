@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/sink.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "io/sink.h"
 
 static sph_status csv_close(sph_sink *sink, sph_error *err) {
   sph_atomic_file *af = sink->data;

@@ -4,8 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "sph/reference.h"
-#include "sph/stability.h"
+#include "solver/reference.h"
+#include "solver/stability.h"
 
 static void json_string(FILE *f, const char *s) {
   fputc('"', f);

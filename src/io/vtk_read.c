@@ -12,7 +12,7 @@
 #include <string.h>
 #include <zlib.h>
 
-#include "sph/vtk_read.h"
+#include "io/vtk_read.h"
 
 /* The file's bytes, NUL-terminated (binary data may hold more NULs). */
 static sph_status slurp(const char *path, char **data, size_t *size,

@@ -20,8 +20,8 @@
 #include <string.h>
 #include <zlib.h>
 
-#include "sph/domain.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "parallel/domain.h"
 
 typedef struct vtk_sink {
   char dir[1024];

@@ -3,8 +3,8 @@
  * W = lambda/2 tr(eps)^2 + mu eps:eps. Not objective, by design.
  * Acoustic tensor for direction e_d: Q_ik = mu d_ik + (lambda + mu) d_id d_kd,
  * whatever F. */
+#include "core/tensor.h"
 #include "materials/material_impl.h"
-#include "sph/tensor.h"
 
 static void small_strain(const double F[9], double eps[9]) {
   for (int i = 0; i < 3; ++i)

@@ -3,8 +3,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/tensor.h"
 #include "materials/material_impl.h"
-#include "sph/tensor.h"
 
 static const sph_material_ops *const models[] = {
     &sph_linear_elastic_ops,

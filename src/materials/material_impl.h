@@ -2,7 +2,7 @@
 #ifndef SPH_MATERIAL_IMPL_H
 #define SPH_MATERIAL_IMPL_H
 
-#include "sph/material.h"
+#include "materials/material.h"
 
 extern const sph_material_ops sph_linear_elastic_ops;
 extern const sph_material_ops sph_neo_hookean_ops;

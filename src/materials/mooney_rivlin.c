@@ -4,8 +4,8 @@
  * eq. 9-10 and p = kappa (J - 1) (eq. 11). W is shifted so W(I) = 0. */
 #include <math.h>
 
+#include "core/tensor.h"
 #include "materials/material_impl.h"
-#include "sph/tensor.h"
 
 static void mooney_rivlin_stress(const sph_material *m, const double F[9],
                                  const double H[9], double J, double P[9]) {

@@ -9,8 +9,8 @@
  *        + (5/9 mu s J^-8/3 + kappa) H_id H_kd. */
 #include <math.h>
 
+#include "core/tensor.h"
 #include "materials/material_impl.h"
-#include "sph/tensor.h"
 
 static void neo_hookean_stress(const sph_material *m, const double F[9],
                                const double H[9], double J, double P[9]) {

@@ -4,7 +4,7 @@
 
 #include <string.h>
 
-#include "sph/sim.h"
+#include "solver/sim.h"
 
 extern const sph_method_ops tl_jst_method_ops;
 extern const sph_method_ops tl_csph_method_ops;

@@ -10,10 +10,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/corrections.h"
+#include "core/tensor.h"
 #include "methods/tl_common_impl.h"
 #include "methods/tl_iact.h"
-#include "sph/corrections.h"
-#include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 /* ---- mirror images

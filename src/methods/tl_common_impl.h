@@ -10,13 +10,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/corrections.h"
+#include "core/neighbors.h"
+#include "core/tensor.h"
 #include "integrators/integrator_impl.h"
+#include "materials/material.h"
 #include "methods/tl_iact.h"
-#include "sph/corrections.h"
-#include "sph/material.h"
-#include "sph/neighbors.h"
-#include "sph/sim.h"
-#include "sph/tensor.h"
+#include "solver/sim.h"
 
 /* The output fields the total-Lagrangian methods fill (sph_method_ops). */
 #define TL_OUTPUT_FIELDS                                                       \

@@ -9,7 +9,7 @@
 
 #include <string.h>
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 /* Two doubles in one register (GCC and Clang vector extension), so that a
  * sweep keeps its twelve sums in registers rather than on the stack. */

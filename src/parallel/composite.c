@@ -6,7 +6,7 @@
  * histogram summed over the ranks, as sph_domain_rcb_counted bisects
  * coordinates by counting). Without MPI, or without a domain, each call
  * works on this rank's values alone. */
-#include "sph/composite.h"
+#include "parallel/composite.h"
 
 #include <math.h>
 #include <string.h>

@@ -6,7 +6,7 @@
  * rank's share of the particles, without the whole set. Every MPI call of
  * sph is in this file and domain_dynamic.c (the updated-Lagrangian
  * rebuild). */
-#include "sph/domain.h"
+#include "parallel/domain.h"
 #include "parallel/domain_impl.h"
 
 #include <limits.h>

@@ -5,7 +5,7 @@
 #ifndef SPH_DOMAIN_IMPL_H
 #define SPH_DOMAIN_IMPL_H
 
-#include "sph/domain.h"
+#include "parallel/domain.h"
 
 typedef struct sph_domain_dyn sph_domain_dyn;
 

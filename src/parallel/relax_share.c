@@ -4,13 +4,13 @@
  * positions refreshed along the same plan, min/max reductions, and every
  * rank's points broadcast in chunks in rank order. Without MPI (or a
  * launcher): one rank, no ghosts. */
-#include "sph/relax_share.h"
+#include "parallel/relax_share.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/domain.h"
+#include "parallel/domain.h"
 
 #ifdef SPH_HAVE_MPI
 #include <mpi.h>

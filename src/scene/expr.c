@@ -7,7 +7,7 @@
  * only given text that parses, and errors can name a position. Its parser
  * keeps global state and evaluation writes the variable values into the
  * evaluator, so neither step is thread-safe. */
-#include "sph/expr.h"
+#include "scene/expr.h"
 
 #include <matheval.h>
 #include <stdlib.h>

@@ -13,17 +13,17 @@
  *     integral of W over its boundary), and kept dp/2 inside the faces;
  *     over MPI ranks each rank relaxes a slice of the points, with the
  *     serial neighbour lists and sums (issue 20). */
-#include "sph/geometry.h"
+#include "scene/geometry.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/domain.h"
-#include "sph/kernel.h"
-#include "sph/neighbors.h"
-#include "sph/relax_share.h"
+#include "core/kernel.h"
+#include "core/neighbors.h"
+#include "parallel/domain.h"
+#include "parallel/relax_share.h"
 
 /* ---- shapes ------------------------------------------------------------- */
 

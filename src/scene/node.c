@@ -3,7 +3,7 @@
  * their file, line, column and dotted path; duplicate keys rejected; typed
  * getters that fill defaults and mark keys used; --set overrides; a block
  * YAML writer on libyaml's emitter; Levenshtein "did you mean" hints. */
-#include "sph/node.h"
+#include "scene/node.h"
 
 #define SPH_SCENE_MAX_BYTES (1 << 20)
 

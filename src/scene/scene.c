@@ -8,17 +8,17 @@
  * reference blocks are left to their users. Over MPI ranks a rank can make
  * its share of the particles alone (issue 20): the bodies' particles
  * visited three times, counted per cell of the Morton order's grid. */
-#include "sph/scene.h"
+#include "scene/scene.h"
 
 #include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/expr.h"
-#include "sph/geometry.h"
-#include "sph/neighbors.h"
-#include "sph/stability.h"
+#include "core/neighbors.h"
+#include "scene/expr.h"
+#include "scene/geometry.h"
+#include "solver/stability.h"
 
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 

@@ -12,14 +12,14 @@
  * mode is the sum of its mean part m = (A + B + C)/3 at w_d and its zero-sum
  * part A_i - m at w_s. Both parts meet the symmetry (X_i = 0) and
  * skew-symmetry (X_i = 1) planes. */
-#include "sph/reference.h"
+#include "solver/reference.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/domain.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "parallel/domain.h"
 
 typedef enum { REF_SWINGING_CUBE, REF_SWINGING_PLATE, REF_PERIOD } ref_kind;
 

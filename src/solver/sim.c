@@ -1,12 +1,12 @@
 /* The simulation object and its time step: particles from the scene, the
  * method from the registry, the terms the method created (DESIGN.md sec. 2,
  * 4). The loop calls method->stable_dt and method->step once per step. */
-#include "sph/sim.h"
+#include "solver/sim.h"
 
-#include "sph/domain.h"
-#include "sph/geometry.h"
-#include "sph/reference.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "parallel/domain.h"
+#include "scene/geometry.h"
+#include "solver/reference.h"
 
 #include <math.h>
 #include <omp.h>

@@ -1,13 +1,13 @@
 /* Stability indicators and the verdict of a run (see stability.h); over
  * MPI ranks each rank judges its owned particles and the indicators are
  * reduced over the ranks (sph_domain_*). */
-#include "sph/stability.h"
+#include "solver/stability.h"
 
-#include "sph/domain.h"
-#include "sph/geometry.h"
-#include "sph/material.h"
-#include "sph/neighbors.h"
-#include "sph/tensor.h"
+#include "core/neighbors.h"
+#include "core/tensor.h"
+#include "materials/material.h"
+#include "parallel/domain.h"
+#include "scene/geometry.h"
 
 #include <math.h>
 #include <stdio.h>

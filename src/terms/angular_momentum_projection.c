@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 #include "terms/terms_impl.h"
 
 /* The sums run over a fixed number of blocks of consecutive particles,

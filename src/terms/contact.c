@@ -29,7 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/material.h"
+#include "materials/material.h"
 #include "terms/terms_impl.h"
 
 typedef struct contact {

@@ -35,9 +35,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/corrections.h"
-#include "sph/domain.h"
-#include "sph/tensor.h"
+#include "core/corrections.h"
+#include "core/tensor.h"
+#include "parallel/domain.h"
 #include "terms/terms_impl.h"
 
 #define LP_MAX_POINTS 4096

@@ -1,7 +1,7 @@
 /* The terms a method composes and the method's named timers (DESIGN.md
  * sec. 4): methods add them in setup; each rates / constrain hook is run in
  * order and timed for summary.json's terms. */
-#include "sph/sim.h"
+#include "solver/sim.h"
 
 #include <string.h>
 

@@ -6,8 +6,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sph/neighbors.h"
-#include "sph/sim.h"
+#include "core/neighbors.h"
+#include "solver/sim.h"
 
 /* Projects a per-particle vector field w (3 per particle, e.g. the internal
  * forces) so that sum V w = 0 and sum V X x w = 0 over each body, in the

@@ -2,7 +2,7 @@
  * tests/unit/test_image_util.h): usage make_test_pngs DIR. */
 #include <stdio.h>
 
-#include "sph/image.h"
+#include "render/image.h"
 #include "test_image_util.h"
 
 int main(int argc, char **argv) {

@@ -20,9 +20,9 @@
 #include <unistd.h>
 
 #include "app/app_impl.h"
-#include "sph/node.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
+#include "scene/node.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 #define FUZZ_MAX_MEMORY 16e6
 /* the particle relaxation is work a scene asks for, linear in its steps

@@ -6,7 +6,7 @@
 #include <check.h>
 #include <stdlib.h>
 
-#include "sph/domain.h"
+#include "parallel/domain.h"
 
 static inline int sph_mpi_check_run(Suite *s) {
   SRunner *sr = srunner_create(s);

@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "mpi_check.h"
-#include "sph/scene.h"
+#include "scene/scene.h"
 #include "test_scene_util.h"
 
 #define SAME(a, b, n) (memcmp((a), (b), (n) * sizeof *(a)) == 0)

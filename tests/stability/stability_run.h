@@ -13,9 +13,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/stability.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
+#include "solver/stability.h"
 
 typedef struct outcome {
   int stable, nan;

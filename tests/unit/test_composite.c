@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include "gl_impl.h"
-#include "sph/composite.h"
+#include "parallel/composite.h"
 
 enum { W = 160, H = 121, N = 300, RANKS = 3 }; /* an odd height: a middle row */
 

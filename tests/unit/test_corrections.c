@@ -15,8 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/corrections.h"
-#include "sph/tensor.h"
+#include "core/corrections.h"
+#include "core/tensor.h"
 
 typedef struct cloud_data {
   size_t n;

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "gl_impl.h"
-#include "sph/image.h"
+#include "render/image.h"
 
 #define W 320
 #define H 240

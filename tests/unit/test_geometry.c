@@ -13,8 +13,8 @@
 #include <omp.h>
 #endif
 
-#include "sph/expr.h"
-#include "sph/geometry.h"
+#include "scene/expr.h"
+#include "scene/geometry.h"
 
 #define EPS DBL_EPSILON
 

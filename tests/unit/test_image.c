@@ -12,7 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "sph/image.h"
+#include "render/image.h"
 #include "test_image_util.h"
 
 static char tmpdir[64];

@@ -4,7 +4,7 @@
 #ifndef SPH_TEST_IMAGE_UTIL_H
 #define SPH_TEST_IMAGE_UTIL_H
 
-#include "sph/image.h"
+#include "render/image.h"
 
 /* Sets one pixel (no bounds check). */
 static inline void sph_test_pixel(sph_image *img, int x, int y, int r, int g,

@@ -10,8 +10,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "sph/sink.h"
-#include "sph/stability.h"
+#include "io/sink.h"
+#include "solver/stability.h"
 
 static int exists(const char *p) {
   struct stat st;

@@ -6,7 +6,7 @@
 
 #include <math.h>
 
-#include "sph/kernel.h"
+#include "core/kernel.h"
 
 static double lattice_integral(const sph_kernel *k, double dx, int grad_axis) {
   int n = (int)ceil(k->support / dx) + 1;

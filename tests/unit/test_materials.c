@@ -6,8 +6,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "sph/material.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "materials/material.h"
 
 static uint64_t rng = 1;
 static double urand(void) { /* splitmix64 */

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/neighbors.h"
+#include "core/neighbors.h"
 
 static uint64_t rng_state;
 static double urand(void) {

@@ -10,7 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "sph/node.h"
+#include "scene/node.h"
 
 static const char *doc = "name: column\n"
                          "materials:\n"

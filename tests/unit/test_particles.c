@@ -5,7 +5,7 @@
 
 #include <string.h>
 
-#include "sph/particles.h"
+#include "core/particles.h"
 
 START_TEST(fields_on_demand) {
   sph_particles *ps;

@@ -19,9 +19,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "sph/render.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 static char dir[] = "/tmp/sph_png_async_XXXXXX";
 

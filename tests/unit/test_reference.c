@@ -11,10 +11,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/reference.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "scene/scene.h"
+#include "solver/reference.h"
+#include "solver/sim.h"
 
 /* a 2D box and the given reference line */
 static sph_status load_plate(const char *reference, sph_scene **s,

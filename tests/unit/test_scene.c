@@ -9,7 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/scene.h"
+#include "scene/scene.h"
 
 static const char *const good =
     "name: column\n"           /* 1 */

@@ -8,7 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/scene.h"
+#include "scene/scene.h"
 
 /* name, dimension, method, one material "m" and the start of the bodies */
 #define SPH_TEST_SCENE_HEAD(dim)                                               \

@@ -12,9 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/geometry.h"
-#include "sph/particles.h"
-#include "sph/scene.h"
+#include "core/particles.h"
+#include "scene/geometry.h"
+#include "scene/scene.h"
 #include "test_scene_util.h"
 
 static int same(const void *a, const void *b, size_t n) {

@@ -9,7 +9,7 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 static uint64_t rng = 3;
 static double urand(void) {

@@ -12,9 +12,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/stability.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
+#include "solver/stability.h"
 
 /* one rubber box [0, lx] x [0, ly] (x [0, lz]) with spacing dp, plus `extra`
  * YAML lines (more bodies, a stability block) */

@@ -13,10 +13,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/material.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "materials/material.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 static sph_sim *make_sim(const char *method, const char *velocity,
                          sph_scene **scene) {

@@ -11,8 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/scene.h"
-#include "sph/sim.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 #define BLOCK_MATERIAL                                                         \
   "materials: {rubber: {model: neo-hookean, density: 1000, "                   \

@@ -23,9 +23,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 #define ROUNDOFF 1e-10
 #define TURN "{rotate: {axis: [1, 2, 3], angle: 37}}"

@@ -11,10 +11,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/reference.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "scene/scene.h"
+#include "solver/reference.h"
+#include "solver/sim.h"
 
 static void run_to_end(sph_sim *sim) {
   sph_error err;

@@ -10,12 +10,12 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "sph/corrections.h"
-#include "sph/neighbors.h"
-#include "sph/reference.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/tensor.h"
+#include "core/corrections.h"
+#include "core/neighbors.h"
+#include "core/tensor.h"
+#include "scene/scene.h"
+#include "solver/reference.h"
+#include "solver/sim.h"
 
 static const char *const cube =
     "name: spinning_cube\ndimension: 3\n"

@@ -11,9 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/tensor.h"
+#include "core/tensor.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 static sph_sim *make_sim(const char *method, int count, sph_scene **scene) {
   char text[2048];

@@ -11,11 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/tensor.h"
 #include "methods/ul_sph/ul_sph_iact.h"
 #include "methods/ul_sph/ul_sph_impl.h"
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/tensor.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 
 /* ---- pair interactions ------------------------------------------------ */
 

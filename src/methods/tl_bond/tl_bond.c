@@ -21,11 +21,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/corrections.h"
+#include "core/tensor.h"
 #include "methods/registry_impl.h"
 #include "methods/tl_bond/tl_bond_iact.h"
 #include "methods/tl_bond/tl_bond_impl.h"
-#include "sph/corrections.h"
-#include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 /* ---- deformation and stress

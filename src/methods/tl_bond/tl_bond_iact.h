@@ -8,7 +8,7 @@
 
 #include <math.h>
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 /* Fc += (x_b - x_a) (x) q_ab */
 static inline void tl_bond_iact_defgrad(double Fc[9], const double xa[3],

@@ -8,10 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/tensor.h"
 #include "methods/registry_impl.h"
 #include "methods/tl_csph/tl_csph_iact.h"
 #include "methods/tl_csph/tl_csph_impl.h"
-#include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 /* F from positions for the particles, images mirrored, ghosts' from their

@@ -12,12 +12,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/corrections.h"
+#include "core/tensor.h"
 #include "methods/registry_impl.h"
 #include "methods/tl_iact.h"
 #include "methods/tl_jst/tl_jst_iact.h"
 #include "methods/tl_jst/tl_jst_impl.h"
-#include "sph/corrections.h"
-#include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 /* ---- stress and state

@@ -5,7 +5,7 @@
 #ifndef SPH_TL_JST_IACT_H
 #define SPH_TL_JST_IACT_H
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 /* Symmetric force of seed 003 eq. 11: dp_a += (P_a + P_b) V_b grad_b(X_a),
  * accumulated as T_a -= ... so that dp = -T; g_ab = V_b grad_b(X_a) */

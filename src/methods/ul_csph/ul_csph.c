@@ -14,10 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/tensor.h"
 #include "methods/registry_impl.h"
 #include "methods/ul_csph/ul_csph_iact.h"
 #include "methods/ul_csph/ul_csph_impl.h"
-#include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 /* f (eq. 12-13, stabilised by eq. 17 / 21 when eta > 0), F = f F^r, images

@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "methods/ul_csph/ul_csph_impl.h"
-#include "sph/domain.h"
+#include "parallel/domain.h"
 
 /* supports around the owned box within which images are placed (the ghosts'
  * depth, solver/sim.c): an image near an owned particle reads its

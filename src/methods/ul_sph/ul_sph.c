@@ -37,10 +37,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/tensor.h"
 #include "methods/registry_impl.h"
 #include "methods/ul_sph/ul_sph_iact.h"
 #include "methods/ul_sph/ul_sph_impl.h"
-#include "sph/tensor.h"
 #include "terms/terms_impl.h"
 
 /* ---- configuration --------------------------------------------------- */

@@ -14,7 +14,7 @@
 
 #include <math.h>
 
-#include "sph/tensor.h"
+#include "core/tensor.h"
 
 /* a . b over the first dim components (dim a constant where inlined) */
 static inline double ul_sph_iact_dot(const double a[3], const double b[3],

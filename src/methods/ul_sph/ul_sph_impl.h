@@ -4,8 +4,8 @@
 
 #include <stddef.h>
 
-#include "sph/neighbors.h"
-#include "sph/sim.h"
+#include "core/neighbors.h"
+#include "solver/sim.h"
 
 typedef enum ul_shear {
   UL_SHEAR_ORIGINAL,          /* SPH-OG: eq. 6-8, 17-18 */

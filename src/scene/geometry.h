@@ -7,7 +7,7 @@
 
 #include <stddef.h>
 
-#include "sph/scene.h"
+#include "scene/scene.h"
 #include "sph/status.h"
 
 /* Signed distance from X to the shape's surface (negative inside). 2D shapes

@@ -11,12 +11,12 @@
 
 #include <stddef.h>
 
-#include "sph/domain.h"
-#include "sph/kernel.h"
-#include "sph/neighbors.h"
-#include "sph/node.h"
-#include "sph/particles.h"
-#include "sph/scene.h"
+#include "core/kernel.h"
+#include "core/neighbors.h"
+#include "core/particles.h"
+#include "parallel/domain.h"
+#include "scene/node.h"
+#include "scene/scene.h"
 #include "sph/status.h"
 
 /* A stable time step below this fraction of the largest one of the run

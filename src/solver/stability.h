@@ -68,9 +68,9 @@
 #ifndef SPH_STABILITY_H
 #define SPH_STABILITY_H
 
-#include "sph/neighbors.h"
-#include "sph/reference.h"
-#include "sph/sink.h"
+#include "core/neighbors.h"
+#include "io/sink.h"
+#include "solver/reference.h"
 
 /* The indicators, in the order a frame checks them: enum name, the key in
  * summary.json and `sph run`'s verdict line. `step` is a time step that

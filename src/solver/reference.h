@@ -36,9 +36,9 @@
 #ifndef SPH_REFERENCE_H
 #define SPH_REFERENCE_H
 
-#include "sph/scene.h"
-#include "sph/sim.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
 #include "sph/status.h"
 
 typedef struct sph_reference sph_reference;

@@ -36,8 +36,8 @@
 #ifndef SPH_CHECKPOINT_H
 #define SPH_CHECKPOINT_H
 
-#include "sph/sim.h"
-#include "sph/stability.h"
+#include "solver/sim.h"
+#include "solver/stability.h"
 #include "sph/status.h"
 
 /* 3: particles in Morton storage order (sph_particles_sort_morton);

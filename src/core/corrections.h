@@ -29,8 +29,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sph/kernel.h"
-#include "sph/neighbors.h"
+#include "core/kernel.h"
+#include "core/neighbors.h"
 #include "sph/status.h"
 
 /* Which corrected gradient a method asks for. */

@@ -10,10 +10,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sph/kernel.h"
-#include "sph/material.h"
-#include "sph/node.h"
-#include "sph/particles.h"
+#include "core/kernel.h"
+#include "core/particles.h"
+#include "materials/material.h"
+#include "scene/node.h"
 #include "sph/status.h"
 
 #define SPH_NAME_MAX 64

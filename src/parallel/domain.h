@@ -14,8 +14,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sph/neighbors.h"
-#include "sph/particles.h"
+#include "core/neighbors.h"
+#include "core/particles.h"
 #include "sph/status.h"
 
 typedef struct sph_domain sph_domain;

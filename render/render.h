@@ -5,8 +5,8 @@
 #ifndef SPH_RENDER_H
 #define SPH_RENDER_H
 
-#include "sph/sim.h"
-#include "sph/sink.h"
+#include "io/sink.h"
+#include "solver/sim.h"
 #include "sph/status.h"
 
 /* Renders and writes each frame on a render thread of its own: `write`

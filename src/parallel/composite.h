@@ -14,7 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sph/domain.h"
+#include "parallel/domain.h"
 #include "sph/status.h"
 
 /* One composited pixel: the layer (1-based, 0: no fragment), the window

@@ -5,7 +5,7 @@
 
 #include <stdio.h>
 
-#include "sph/sim.h"
+#include "solver/sim.h"
 #include "sph/status.h"
 
 /* What a sink sees at an output time (after method->derive). */
