@@ -67,6 +67,9 @@ typedef struct sph_run_options {
    * boundary with outputs finished and a checkpoint written (a signal
    * handler sets it; NULL: never) */
   const volatile int *stop;
+  /* 1: write nothing (no folder, sinks, checkpoints or summary.json): the
+   * run is only stepped and judged, as `sph bench` and the tests do */
+  int no_files;
 } sph_run_options;
 
 /* Sets up particles, the method and its terms, the verdict and the sinks,
