@@ -298,6 +298,10 @@ int sph_scene_find_body(const sph_scene *s, const char *name);
 void sph_body_local(const sph_body *b, const double X[3], double Xb[3]);
 void sph_body_world(const sph_body *b, const double Xb[3], double X[3]);
 
+/* out = R v, the rotation of placement T. */
+void sph_transform_rotate(const sph_transform *T, const double v[3],
+                          double out[3]);
+
 /* The coordinate axis (0, 1, 2) the unit vector n is, or -1. */
 int sph_axis_index(const double n[3]);
 
