@@ -25,7 +25,9 @@
  * centroid along the axis closest to the view direction, so the cut face
  * looks at the camera.
  * `ghost` paints the reference configuration as a grey outlined silhouette
- * under the current state. sph_png_check validates all of this before a run.
+ * under the current state. The block's keys, defaults and value checks are
+ * the sink's own schema (png_schema.c, read when the scene loads);
+ * sph_png_check validates the picture they give before a run.
  * Created only when the scene has a `png` block.
  *
  * Threading: `write` runs on the simulation thread only as long as it takes
@@ -53,6 +55,7 @@
 #include "parallel/composite.h"
 #include "parallel/domain.h"
 #include "render/image.h"
+#include "render/png_schema.h"
 #include "render/render.h"
 #include "scene/geometry.h"
 
@@ -379,30 +382,13 @@ static sph_status cut_mask(const sph_sim *sim, const sph_view *v,
   return SPH_OK;
 }
 
-/* The png block's child `key` (or the block itself when the key is absent,
- * NULL without a block): where errors about the frames point. */
-static const sph_node *png_node(const sph_scene *s, const char *key) {
-  const sph_node *n = s->root ? sph_node_child(s->root, "output") : NULL;
-  n = n ? sph_node_child(n, "png") : NULL;
-  const sph_node *k = n && key ? sph_node_child(n, key) : NULL;
-  return k ? k : n;
-}
-
-/* An error at node n, or without a location when there is none. */
-static sph_status png_error(const sph_node *n, sph_error *err,
-                            const char *msg) {
-  if (n)
-    return sph_node_error(n, err, SPH_ERR_RANGE, "%s", msg);
-  return sph_error_set(err, SPH_ERR_RANGE, "output.png: %s", msg);
-}
-
 sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
   const sph_scene *s = sim->scene;
   const sph_png_output *o = &s->output.png;
   if (!o->enabled)
     return SPH_OK;
   const sph_particles *ps = sim->ps;
-  const sph_node *cam = png_node(s, "camera");
+  const sph_node *cam = sph_png_schema_node(s->root, "camera");
   char msg[1024];
   sph_view v;
   double box[2][3];
@@ -410,7 +396,7 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
   sph_error verr;
   if (sph_view_check(&v, &verr) != SPH_OK) {
     snprintf(msg, sizeof msg, "unusable camera (%s)", verr.message);
-    return png_error(cam, err, msg);
+    return sph_png_schema_error(cam, err, msg);
   }
   /* an eye inside a body would see the particles from within */
   for (size_t b = 0; s->dimension == 3 && b < s->nbodies; ++b) {
@@ -422,7 +408,7 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
                "the camera at (%g, %g, %g) is inside body '%s'; place it "
                "outside every body",
                v.eye[0], v.eye[1], v.eye[2], s->bodies[b].name);
-      return png_error(pos ? pos : cam, err, msg);
+      return sph_png_schema_error(pos ? pos : cam, err, msg);
     }
   }
   /* something left after the cutaways, and something of it in view */
@@ -452,7 +438,7 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
   if (N > 0 && kept == 0) {
     snprintf(msg, sizeof msg, "the clip plane keeps none of the %zu particles",
              N);
-    return png_error(png_node(s, "clip"), err, msg);
+    return sph_png_schema_error(sph_png_schema_node(s->root, "clip"), err, msg);
   }
   if (kept > 0 && seen == 0) {
     snprintf(msg, sizeof msg,
@@ -460,7 +446,7 @@ sph_status sph_png_check(const sph_sim *sim, sph_error *err) {
              "of the %zu particles; aim it at the bodies",
              v.eye[0], v.eye[1], v.eye[2], v.target[0], v.target[1],
              v.target[2], kept);
-    return png_error(cam, err, msg);
+    return sph_png_schema_error(cam, err, msg);
   }
   return SPH_OK;
 }

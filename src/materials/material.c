@@ -1,34 +1,27 @@
-/* Material registry and parameter checks: (E, nu) or (mu, kappa) to the
- * Lame parameters; p-wave speed sqrt((lambda + 2 mu) / rho0). */
+/* Material parameters: (E, nu) or (mu, kappa) to the Lame parameters, the
+ * model's own parameters checked by the model; p-wave speed
+ * sqrt((lambda + 2 mu) / rho0) and acoustic tensors. The registry is in
+ * registry.c. */
 #include <math.h>
 #include <string.h>
 
 #include "core/tensor.h"
 #include "materials/material_impl.h"
 
-static const sph_material_ops *const models[] = {
-    &sph_linear_elastic_ops,
-    &sph_neo_hookean_ops,
-    &sph_mooney_rivlin_ops,
-    NULL,
-};
-
-static const char *const model_names[] = {"linear-elastic", "neo-hookean",
-                                          "mooney-rivlin", NULL};
-
-const char *const *sph_material_models(void) { return model_names; }
-
 sph_status sph_material_create(sph_material *m, const sph_material_params *p,
                                sph_error *err) {
   memset(m, 0, sizeof *m);
-  for (const sph_material_ops *const *o = models; *o; ++o)
-    if (p->model && strcmp((*o)->name, p->model) == 0)
-      m->ops = *o;
+  m->ops = sph_material_find(p->model);
   if (!m->ops)
     return sph_error_set(err, SPH_ERR_ARG,
-                         "unknown material model '%s' (known: linear-elastic, "
-                         "neo-hookean, mooney-rivlin)",
-                         p->model ? p->model : "");
+                         "unknown material model '%s' (known: %s)",
+                         p->model ? p->model : "", sph_material_known());
+  SPH_TRY(sph_material_elastic(m, p, err));
+  return sph_material_own(m, p, err);
+}
+
+sph_status sph_material_elastic(sph_material *m, const sph_material_params *p,
+                                sph_error *err) {
   if (!(p->density > 0.0))
     return sph_error_set(err, SPH_ERR_RANGE, "density must be positive, got %g",
                          p->density);
@@ -44,8 +37,8 @@ sph_status sph_material_create(sph_material *m, const sph_material_params *p,
       return sph_error_set(err, SPH_ERR_RANGE,
                            "Young's modulus must be positive, got %g", E);
     if (!(nu > -1.0 && nu < 0.5))
-      return sph_error_set(err, SPH_ERR_RANGE,
-                           "Poisson's ratio must be in (-1, 0.5), got %g", nu);
+      return sph_error_at(err, SPH_ERR_RANGE, NULL, 0, 0, "poisson_ratio",
+                          "must be in (-1, 0.5), got %g", nu);
     mu = E / (2.0 * (1.0 + nu));
     kappa = E / (3.0 * (1.0 - 2.0 * nu));
   } else {
@@ -66,20 +59,32 @@ sph_status sph_material_create(sph_material *m, const sph_material_params *p,
   m->mu = mu;
   m->kappa = kappa;
   m->lambda = kappa - 2.0 * mu / 3.0;
-  /* seed 000 eq. 8: 2 varsigma + 3 sqrt(3) xi = mu */
-  double xi = p->has_xi ? p->xi : 0.0;
-  double xi_max = mu / (3.0 * sqrt(3.0));
-  if (p->has_xi && m->ops != &sph_mooney_rivlin_ops)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "xi applies to mooney-rivlin only, not %s",
-                         m->ops->name);
-  if (!(xi >= 0.0 && xi <= xi_max))
-    return sph_error_set(err, SPH_ERR_RANGE,
-                         "xi must be in [0, mu/(3 sqrt 3)] = [0, %g], got %g",
-                         xi_max, xi);
-  m->xi = xi;
-  m->varsigma = 0.5 * (mu - 3.0 * sqrt(3.0) * xi);
   return SPH_OK;
+}
+
+sph_status sph_material_own(sph_material *m, const sph_material_params *p,
+                            sph_error *err) {
+  for (int i = 0; i < p->nown; ++i) {
+    int mine = 0;
+    for (const char *const *k = m->ops->keys; k && *k && !mine; ++k)
+      mine = !strcmp(*k, p->own_key[i]);
+    if (mine)
+      continue;
+    char owners[256];
+    sph_material_owners(p->own_key[i], owners, sizeof owners);
+    return sph_error_at(err, SPH_ERR_ARG, NULL, 0, 0, p->own_key[i],
+                        "%s applies to %s only, not %s", p->own_key[i],
+                        owners[0] ? owners : "no model", m->ops->name);
+  }
+  return m->ops->init ? m->ops->init(m, p, err) : SPH_OK;
+}
+
+double sph_material_param(const sph_material_params *p, const char *key,
+                          double def) {
+  for (int i = 0; i < p->nown; ++i)
+    if (!strcmp(p->own_key[i], key))
+      return p->own_value[i];
+  return def;
 }
 
 double sph_material_wave_speed(const sph_material *m) {

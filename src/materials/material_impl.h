@@ -1,11 +1,14 @@
-/* The constitutive models' ops tables (one file each) for the registry. */
+/* The constitutive models' ops tables (one file each), declared from the
+ * model list for the registry. */
 #ifndef SPH_MATERIAL_IMPL_H
 #define SPH_MATERIAL_IMPL_H
 
 #include "materials/material.h"
+#include "materials/material_list.h"
 
-extern const sph_material_ops sph_linear_elastic_ops;
-extern const sph_material_ops sph_neo_hookean_ops;
-extern const sph_material_ops sph_mooney_rivlin_ops;
+#define SPH_MATERIAL_EXTERN(id, name)                                          \
+  extern const sph_material_ops sph_##id##_ops;
+SPH_MATERIAL_LIST(SPH_MATERIAL_EXTERN)
+#undef SPH_MATERIAL_EXTERN
 
 #endif

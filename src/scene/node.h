@@ -70,6 +70,9 @@ sph_status sph_node_missing(const sph_node *map, const char *key,
  * are errors at the value. */
 sph_status sph_node_get_double(sph_node *map, const char *key, int required,
                                double def, double *out, sph_error *err);
+/* A double that must be > 0 ("must be positive, got %g" at the key). */
+sph_status sph_node_get_positive(sph_node *map, const char *key, int required,
+                                 double def, double *out, sph_error *err);
 sph_status sph_node_get_int(sph_node *map, const char *key, int required,
                             long def, long *out, sph_error *err);
 sph_status sph_node_get_bool(sph_node *map, const char *key, int required,

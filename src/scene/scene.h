@@ -13,6 +13,7 @@
 #include "core/kernel.h"
 #include "core/particles.h"
 #include "materials/material.h"
+#include "render/png_schema.h"
 #include "scene/node.h"
 #include "sph/status.h"
 
@@ -170,33 +171,6 @@ typedef struct sph_probe {
   int line, col;
 } sph_probe;
 
-typedef struct sph_camera {
-  int given;
-  double position[3], target[3], up[3];
-  int has_position;
-  double azimuth, elevation, zoom;
-  int orthographic;
-  int follow; /* refit to the current bodies (fitted cameras only) */
-} sph_camera;
-
-typedef struct sph_png_output {
-  int enabled;
-  int width, height;
-  int color_field;     /* sph_field */
-  char range_mode[16]; /* robust | auto | symmetric | fixed | global */
-  char colormap[16];   /* cool-warm | viridis; empty: the field's own */
-  double range[2];
-  sph_camera camera;
-  int mp4;    /* assemble <scene>.mp4 from the frames after the run */
-  double fps; /* its frame rate */
-  int clip;   /* draw only particles with clip_normal . x <= clip_at */
-  double clip_normal[3], clip_at;
-  int cut_half;  /* per body, only the half behind its reference centroid */
-  int ghost;     /* the reference configuration drawn behind the frame */
-  int axes;      /* the world axes triad in the bottom-left corner */
-  int scale_bar; /* a length scale at the camera's target */
-} sph_png_output;
-
 typedef struct sph_output {
   double every;
   int vtk;
@@ -297,6 +271,10 @@ int sph_scene_find_body(const sph_scene *s, const char *name);
 /* Position X (world frame) in the frame of body `body`, and back. */
 void sph_body_local(const sph_body *b, const double X[3], double Xb[3]);
 void sph_body_world(const sph_body *b, const double Xb[3], double X[3]);
+
+/* out = R v, the rotation of placement T. */
+void sph_transform_rotate(const sph_transform *T, const double v[3],
+                          double out[3]);
 
 /* The coordinate axis (0, 1, 2) the unit vector n is, or -1. */
 int sph_axis_index(const double n[3]);

@@ -1,0 +1,357 @@
+/* The scene's `bodies:` block: each body's material, shape, particle
+ * lattice (count or spacing, jitter, relaxation), initial velocity (uniform,
+ * rotation, expressions) and placement (a rotation by Rodrigues' formula and
+ * a translation; shape, velocity and own selections in the body frame). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/expr.h"
+#include "scene/schema_impl.h"
+
+static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
+                              sph_error *err) {
+  static const char *const kinds[] = {"box",    "cylinder", "ring", "disc",
+                                      "sphere", "shell",    NULL};
+  if (n->kind != SPH_NODE_MAP)
+    return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
+  SPH_TRY(sph_node_check_keys(n, kinds, err));
+  int which;
+  SPH_TRY(sph_schema_one_of(n, kinds, "shape", &which, err));
+  static const sph_shape_kind map[] = {SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER,
+                                       SPH_SHAPE_RING,   SPH_SHAPE_DISC,
+                                       SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL};
+  memset(sh, 0, sizeof *sh);
+  sh->kind = map[which];
+  sph_node *g;
+  SPH_TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
+  int d = s->dimension;
+  switch (sh->kind) {
+  case SPH_SHAPE_BOX: {
+    static const char *const keys[] = {"min", "max", NULL};
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(sph_node_get_doubles(g, "min", 1, (size_t)d, sh->min, NULL, err));
+    SPH_TRY(sph_node_get_doubles(g, "max", 1, (size_t)d, sh->max, NULL, err));
+    for (int c = 0; c < d; ++c)
+      if (!(sh->max[c] > sh->min[c]))
+        return sph_node_error(sph_node_child(g, "max"), err, SPH_ERR_GEOMETRY,
+                              "empty box: max must exceed min on every axis "
+                              "(axis %s: %g <= %g)",
+                              sph_axis_names[c], sh->max[c], sh->min[c]);
+    break;
+  }
+  case SPH_SHAPE_DISC:
+  case SPH_SHAPE_SPHERE: {
+    static const char *const keys[] = {"center", "radius", NULL};
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(
+        sph_node_get_doubles(g, "center", 1, (size_t)d, sh->center, NULL, err));
+    sph_node *r = sph_node_child(g, "radius");
+    SPH_TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
+    if (!(sh->radius > 0))
+      return sph_node_error(r, err, SPH_ERR_GEOMETRY,
+                            "empty shape: radius must be positive, got %g",
+                            sh->radius);
+    break;
+  }
+  case SPH_SHAPE_CYLINDER: {
+    static const char *const keys[] = {"center", "axis", "radius", "length",
+                                       NULL};
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(sph_node_get_doubles(g, "center", 1, 3, sh->center, NULL, err));
+    SPH_TRY(sph_schema_get_direction(g, "axis", 0, 2, 3, sh->axis, err));
+    SPH_TRY(sph_node_get_double(g, "radius", 1, 0, &sh->radius, err));
+    if (!(sh->radius > 0))
+      return sph_node_error(sph_node_child(g, "radius"), err, SPH_ERR_GEOMETRY,
+                            "empty shape: radius must be positive, got %g",
+                            sh->radius);
+    SPH_TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
+    if (!(sh->length > 0))
+      return sph_node_error(sph_node_child(g, "length"), err, SPH_ERR_GEOMETRY,
+                            "empty shape: length must be positive, got %g",
+                            sh->length);
+    break;
+  }
+  case SPH_SHAPE_RING:
+  case SPH_SHAPE_SHELL: {
+    int tube = sh->kind == SPH_SHAPE_RING && d == 3;
+    static const char *const keys2[] = {"center", "inner_radius",
+                                        "outer_radius", NULL};
+    static const char *const keys3[] = {
+        "center", "inner_radius", "outer_radius", "axis", "length", NULL};
+    SPH_TRY(sph_node_check_keys(g, tube ? keys3 : keys2, err));
+    SPH_TRY(sph_node_get_doubles(g, "center", 1, tube ? 3 : (size_t)d,
+                                 sh->center, NULL, err));
+    SPH_TRY(
+        sph_node_get_double(g, "inner_radius", 1, 0, &sh->inner_radius, err));
+    SPH_TRY(
+        sph_node_get_double(g, "outer_radius", 1, 0, &sh->outer_radius, err));
+    if (!(sh->inner_radius >= 0 && sh->outer_radius > sh->inner_radius))
+      return sph_node_error(sph_node_child(g, "outer_radius"), err,
+                            SPH_ERR_GEOMETRY,
+                            "empty shape: need 0 <= inner_radius < "
+                            "outer_radius, got %g and %g",
+                            sh->inner_radius, sh->outer_radius);
+    if (tube) {
+      SPH_TRY(sph_schema_get_direction(g, "axis", 0, 2, 3, sh->axis, err));
+      SPH_TRY(sph_node_get_double(g, "length", 1, 0, &sh->length, err));
+      if (!(sh->length > 0))
+        return sph_node_error(
+            sph_node_child(g, "length"), err, SPH_ERR_GEOMETRY,
+            "empty shape: length must be positive, got %g", sh->length);
+    }
+    break;
+  }
+  }
+  int is3d = sh->kind == SPH_SHAPE_SPHERE || sh->kind == SPH_SHAPE_SHELL ||
+             sh->kind == SPH_SHAPE_CYLINDER;
+  if ((d == 2 && is3d) || (d == 3 && sh->kind == SPH_SHAPE_DISC))
+    return sph_node_error(sph_node_child(n, kinds[which]), err,
+                          SPH_ERR_GEOMETRY,
+                          "a %s does not exist in %dD (2D: box, disc, ring; "
+                          "3D: box, cylinder, ring, sphere, shell)",
+                          kinds[which], d);
+  return SPH_OK;
+}
+
+static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
+                                  sph_error *err) {
+  static const char *const keys[] = {"count",  "spacing", "distribution",
+                                     "jitter", "seed",    "relax_steps",
+                                     NULL};
+  SPH_TRY(sph_node_check_keys(n, keys, err));
+  static const char *const how[] = {"count", "spacing", NULL};
+  int which;
+  SPH_TRY(sph_schema_one_of(n, how, "of count or spacing", &which, err));
+  int d = s->dimension;
+  if (which == 0) {
+    if (b->shape.kind != SPH_SHAPE_BOX)
+      return sph_node_error(sph_node_child(n, "count"), err, SPH_ERR_ARG,
+                            "particle counts apply to boxes; give a spacing "
+                            "for other shapes");
+    double c[3];
+    SPH_TRY(sph_node_get_doubles(n, "count", 1, (size_t)d, c, NULL, err));
+    b->lattice = SPH_LATTICE_FACES;
+    b->spacing = INFINITY;
+    for (int k = 0; k < d; ++k) {
+      if (c[k] != floor(c[k]) || c[k] < 2 || c[k] > 1e6)
+        return sph_node_error(sph_node_child(n, "count"), err, SPH_ERR_RANGE,
+                              "counts must be whole numbers from 2 to 1e6, "
+                              "got %g",
+                              c[k]);
+      b->count[k] = (int)c[k];
+      double h = (b->shape.max[k] - b->shape.min[k]) / (c[k] - 1);
+      b->spacing = h < b->spacing ? h : b->spacing;
+    }
+  } else {
+    b->lattice = SPH_LATTICE_CELL_CENTRED;
+    SPH_TRY(sph_node_get_positive(n, "spacing", 1, 0, &b->spacing, err));
+  }
+  static const char *const dists[] = {"lattice", "jitter", "relax", NULL};
+  const char *dist;
+  SPH_TRY(sph_node_get_string(n, "distribution", 0, "lattice", &dist, err));
+  int dk = -1;
+  for (int i = 0; dists[i]; ++i)
+    if (!strcmp(dist, dists[i]))
+      dk = i;
+  if (dk < 0)
+    return sph_node_error(sph_node_child(n, "distribution"), err, SPH_ERR_RANGE,
+                          "distribution must be lattice, jitter or relax, got "
+                          "'%s'",
+                          dist);
+  b->distribution = (sph_distribution)dk;
+  if (dk != SPH_DIST_LATTICE) {
+    SPH_TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
+    if (!(b->jitter >= 0.0 && b->jitter < 0.5))
+      return sph_node_error(sph_node_child(n, "jitter"), err, SPH_ERR_RANGE,
+                            "jitter is a fraction of the spacing in [0, 0.5), "
+                            "got %g",
+                            b->jitter);
+    long seed, steps = 0;
+    SPH_TRY(sph_node_get_int(n, "seed", 0, 1, &seed, err));
+    if (seed < 0)
+      return sph_node_error(sph_node_child(n, "seed"), err, SPH_ERR_RANGE,
+                            "seed must be >= 0");
+    b->seed = (unsigned long)seed;
+    if (dk == SPH_DIST_RELAX) {
+      SPH_TRY(sph_node_get_int(n, "relax_steps", 0, 100, &steps, err));
+      if (steps < 0 || steps > 100000)
+        return sph_node_error(sph_node_child(n, "relax_steps"), err,
+                              SPH_ERR_RANGE,
+                              "relax_steps must be in [0, "
+                              "100000]");
+    }
+    b->relax_steps = (int)steps;
+  }
+  return SPH_OK;
+}
+
+static sph_status make_expr(sph_node *n, sph_expr **out, sph_error *err) {
+  if (n->kind != SPH_NODE_SCALAR)
+    return sph_node_error(n, err, SPH_ERR_TYPE, "expected an expression");
+  sph_status st = sph_expr_create(out, n->value, err);
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(n, err, st, "%s", msg);
+  }
+  return SPH_OK;
+}
+
+static sph_status parse_velocity(sph_scene *s, sph_velocity *v, sph_node *n,
+                                 sph_error *err) {
+  static const char *const kinds[] = {"uniform", "rotation", "expression",
+                                      NULL};
+  if (n->kind != SPH_NODE_MAP)
+    return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
+  SPH_TRY(sph_node_check_keys(n, kinds, err));
+  int which;
+  SPH_TRY(sph_schema_one_of(n, kinds, "initial velocity", &which, err));
+  if (which == 0) {
+    v->kind = SPH_VEL_UNIFORM;
+    SPH_TRY(sph_node_get_doubles(n, "uniform", 1, 3, v->value, NULL, err));
+  } else if (which == 1) {
+    v->kind = SPH_VEL_ROTATION;
+    sph_node *r;
+    SPH_TRY(sph_node_get_map(n, "rotation", 1, &r, err));
+    static const char *const keys[] = {"axis", "omega", "center", "profile",
+                                       NULL};
+    SPH_TRY(sph_node_check_keys(r, keys, err));
+    SPH_TRY(sph_schema_get_direction(r, "axis", 1, 2, 3, v->axis, err));
+    SPH_TRY(sph_node_get_double(r, "omega", 1, 0, &v->omega, err));
+    if (sph_node_child(r, "center"))
+      SPH_TRY(sph_node_get_doubles(r, "center", 1, 3, v->center, NULL, err));
+    else
+      SPH_TRY(sph_node_insert_default(r, "center", "[0, 0, 0]",
+                                      &(sph_node *){0}, err));
+    sph_node *p = sph_node_child(r, "profile");
+    if (p) {
+      p->used = 1;
+      SPH_TRY(make_expr(p, &v->profile, err));
+    }
+  } else {
+    v->kind = SPH_VEL_EXPRESSION;
+    sph_node *e;
+    SPH_TRY(sph_schema_get_seq(n, "expression", 1, &e, err));
+    if (e->count != 3)
+      return sph_node_error(e, err, SPH_ERR_TYPE,
+                            "expected three expressions (vx, vy, vz), got %zu",
+                            e->count);
+    for (int c = 0; c < 3; ++c)
+      SPH_TRY(make_expr(e->items[c], &v->expr[c], err));
+  }
+  (void)s;
+  return SPH_OK;
+}
+
+/* cos and sin of an angle in degrees, exact at multiples of 90 */
+static void cos_sin_degrees(double deg, double *c, double *sn) {
+  double q = fmod(deg, 360.0);
+  q += q < 0.0 ? 360.0 : 0.0;
+  static const double exact[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+  if (fmod(q, 90.0) == 0.0) {
+    *c = exact[(int)(q / 90.0) % 4][0];
+    *sn = exact[(int)(q / 90.0) % 4][1];
+    return;
+  }
+  *c = cos(deg * M_PI / 180.0);
+  *sn = sin(deg * M_PI / 180.0);
+}
+
+/* transform: {rotate: {axis, angle}, translate}; R by Rodrigues' formula
+ * R = cos I + sin [a]x + (1 - cos) a a^T; 2D rotates about z */
+static sph_status parse_transform(sph_scene *s, sph_transform *T, sph_node *n,
+                                  sph_error *err) {
+  static const char *const keys[] = {"rotate", "translate", NULL};
+  SPH_TRY(sph_node_check_keys(n, keys, err));
+  int d = s->dimension;
+  memset(T, 0, sizeof *T);
+  T->given = 1;
+  T->R[0] = T->R[4] = T->R[8] = 1.0;
+  sph_node *r;
+  SPH_TRY(sph_node_get_map(n, "rotate", 0, &r, err));
+  if (r) {
+    static const char *const k3[] = {"axis", "angle", NULL};
+    if (d == 2 && sph_node_child(r, "axis"))
+      return sph_node_error(sph_node_child(r, "axis"), err, SPH_ERR_ARG,
+                            "a 2D rotation is about z: give only the angle");
+    SPH_TRY(sph_node_check_keys(r, k3, err));
+    double a[3] = {0.0, 0.0, 1.0}, deg, c, sn;
+    if (d == 3)
+      SPH_TRY(sph_schema_get_direction(r, "axis", 1, 2, 3, a, err));
+    SPH_TRY(sph_node_get_double(r, "angle", 1, 0, &deg, err));
+    if (!isfinite(deg))
+      return sph_node_error(sph_node_child(r, "angle"), err, SPH_ERR_RANGE,
+                            "the angle (degrees) must be finite");
+    cos_sin_degrees(deg, &c, &sn);
+    const double ax[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        T->R[3 * i + j] =
+            (i == j) * c + sn * ax[3 * i + j] + (1.0 - c) * a[i] * a[j];
+  }
+  SPH_TRY(sph_node_get_doubles(n, "translate", 0, (size_t)d, T->t, NULL, err));
+  return SPH_OK;
+}
+
+sph_status sph_schema_bodies(sph_scene *s, sph_node *root, sph_error *err) {
+  sph_node *list;
+  SPH_TRY(sph_schema_get_seq(root, "bodies", 1, &list, err));
+  if (list->count == 0)
+    return sph_node_error(list, err, SPH_ERR_MISSING_KEY,
+                          "define at least one body");
+  s->bodies = calloc(list->count, sizeof *s->bodies);
+  if (!s->bodies)
+    return sph_error_set(err, SPH_ERR_NOMEM, "bodies");
+  static const char *const keys[] = {
+      "name",      "material", "shape", "particles", "initial_velocity",
+      "transform", NULL};
+  for (size_t i = 0; i < list->count; ++i) {
+    sph_node *n = list->items[i];
+    sph_body *b = &s->bodies[i];
+    s->nbodies++;
+    if (n->kind != SPH_NODE_MAP)
+      return sph_node_error(n, err, SPH_ERR_TYPE,
+                            "expected a body (a mapping)");
+    SPH_TRY(sph_node_check_keys(n, keys, err));
+    b->line = n->line;
+    b->col = n->col;
+    const char *name, *mat;
+    SPH_TRY(sph_node_get_string(n, "name", 1, NULL, &name, err));
+    if (!name[0])
+      return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_RANGE,
+                            "a body needs a name");
+    sph_schema_copy_name(b->name, name);
+    for (size_t j = 0; j < i; ++j)
+      if (!strcmp(s->bodies[j].name, name))
+        return sph_node_error(sph_node_child(n, "name"), err, SPH_ERR_ARG,
+                              "two bodies are named '%s'", name);
+    SPH_TRY(sph_node_get_string(n, "material", 1, NULL, &mat, err));
+    b->material = sph_scene_find_material(s, mat);
+    if (b->material < 0) {
+      const char *names[64];
+      size_t k = 0;
+      for (; k < s->nmaterials && k < 63; ++k)
+        names[k] = s->materials[k].name;
+      names[k] = NULL;
+      const char *hint = sph_suggest(mat, names);
+      return sph_node_error(sph_node_child(n, "material"), err, SPH_ERR_ARG,
+                            "no material named '%s'%s%s%s", mat,
+                            hint ? "; did you mean '" : "", hint ? hint : "",
+                            hint ? "'?" : "");
+    }
+    sph_node *shape, *parts, *vel;
+    SPH_TRY(sph_node_get_map(n, "shape", 1, &shape, err));
+    SPH_TRY(parse_shape(s, &b->shape, shape, err));
+    SPH_TRY(sph_node_get_map(n, "particles", 1, &parts, err));
+    SPH_TRY(parse_particles(s, b, parts, err));
+    SPH_TRY(sph_node_get_map(n, "initial_velocity", 0, &vel, err));
+    if (vel)
+      SPH_TRY(parse_velocity(s, &b->velocity, vel, err));
+    sph_node *tr;
+    SPH_TRY(sph_node_get_map(n, "transform", 0, &tr, err));
+    if (tr)
+      SPH_TRY(parse_transform(s, &b->transform, tr, err));
+  }
+  return SPH_OK;
+}
