@@ -68,7 +68,7 @@ sph_status sph_run_open(sph_run **out, const sph_scene *scene,
   if (run->opt.threads > 0)
     omp_set_num_threads(run->opt.threads);
   sph_status st = sph_sim_create(&run->sim, scene, err);
-  if (st == SPH_OK)
+  if (st == SPH_OK && !run->opt.no_files) /* no frames without files */
     st = sph_png_check(run->sim, err);
   if (st == SPH_OK)
     st = sinks_create(run, err);
@@ -355,6 +355,14 @@ static sph_status run_loop(sph_run *run, double t_stop, unsigned long max_steps,
   return SPH_OK;
 }
 
+sph_status sph_sim_advance(sph_sim *sim, double t_until,
+                           unsigned long max_steps, sph_error *err) {
+  double eps = 1e-12 * fabs(t_until);
+  for (unsigned long k = 0; k < max_steps && sim->t < t_until - eps; ++k)
+    SPH_TRY(sph_sim_step(sim, t_until - sim->t, err));
+  return SPH_OK;
+}
+
 sph_status sph_run_advance(sph_run *run, double t_until, sph_error *err) {
   return run_loop(run, fmin(t_until, run->scene->t_end), (unsigned long)-1,
                   err);
@@ -367,9 +375,15 @@ sph_status sph_run_advance_steps(sph_run *run, unsigned long steps,
 
 sph_status sph_run_create(sph_run **out, const sph_scene *scene,
                           const sph_run_options *options, sph_error *err) {
+  return sph_run_create_hooked(out, scene, options, NULL, err);
+}
+
+sph_status sph_run_create_hooked(sph_run **out, const sph_scene *scene,
+                                 const sph_run_options *options,
+                                 const sph_run_hooks *hooks, sph_error *err) {
   sph_run *run = NULL;
   *out = NULL;
-  sph_status st = sph_run_open(&run, scene, options, NULL, err);
+  sph_status st = sph_run_open(&run, scene, options, hooks, err);
   if (st == SPH_OK)
     st = sph_run_folder(run, err);
   if (st == SPH_OK)

@@ -44,6 +44,10 @@ sph_status sph_run_open(sph_run **out, const sph_scene *scene,
                         const sph_run_hooks *hooks, sph_error *err);
 sph_status sph_run_folder(sph_run *run, sph_error *err);
 sph_status sph_run_start(sph_run *run, sph_error *err);
+/* sph_run_create with hooks: every phase, then the first output frame. */
+sph_status sph_run_create_hooked(sph_run **out, const sph_scene *scene,
+                                 const sph_run_options *options,
+                                 const sph_run_hooks *hooks, sph_error *err);
 
 /* The simulation the run steps (the sinks' view of the whole run over MPI
  * ranks: sph_run_view). */
@@ -61,6 +65,12 @@ const char *sph_run_resumed_from(const sph_run *run, int *next_index);
  * stop), through the output times on the way, as sph_run_advance. */
 sph_status sph_run_advance_steps(sph_run *run, unsigned long steps,
                                  sph_error *err);
+
+/* For the tests that drive a simulation without a run: steps, each capped
+ * to land on t_until, while t < t_until (to 1e-12 of it, relative) and
+ * fewer than max_steps were taken. */
+sph_status sph_sim_advance(sph_sim *sim, double t_until,
+                           unsigned long max_steps, sph_error *err);
 
 /* What sph_run_close found, for the command's last lines. */
 typedef struct sph_run_report {
