@@ -25,21 +25,9 @@
 #include "parallel/domain.h"
 #include "render/render.h"
 #include "scene/scene.h"
-#include "solver/sim.h"
+#include "solver/run.h"
 
-#define BENCH_SCHEMA 1
-#define BENCH_MAX_SETS 8
-#define BENCH_MAX_PARTS 24
-
-/* One case: a shipped scene with overrides, run for a fixed step count;
- * `frame` also times a .vtp write and a 1280 x 720 frame of the state. */
-typedef struct bench_case {
-  const char *name;
-  const char *scene;
-  const char *sets[BENCH_MAX_SETS];
-  long steps;
-  int frame;
-} bench_case;
+#include "app/bench_impl.h"
 
 #define PLATE30                                                                \
   "bodies.0.particles.spacing=0.00066666666666666667",                         \
@@ -144,7 +132,7 @@ typedef struct bench_result {
   long max_rss_kb; /* filled by the parent */
 } bench_result;
 
-static const char *const outputs_off[] = {
+const char *const sph_bench_outputs_off[SPH_BENCH_OUTPUTS_OFF] = {
     "output.vtk=false", "output.png=false", "output.probes=[]", "time.end=1e9",
     "output.every=1e8"};
 
@@ -152,6 +140,14 @@ static const char *const outputs_off[] = {
 static const char *const outputs_frame[] = {
     "output.vtk=true", "output.png={width: 1280, height: 720, mp4: false}",
     "output.probes=[]", "time.end=1e9", "output.every=1e8"};
+
+sph_status sph_bench_steps(sph_run *run, unsigned long steps, sph_error *err) {
+  SPH_TRY(sph_run_advance_steps(run, steps, err));
+  if (sph_run_state_of(run) == SPH_RUN_UNSTABLE) /* a step failed */
+    return sph_error_set(err, SPH_ERR_NUMERIC, "%s",
+                         sph_run_verdict(run)->reason);
+  return SPH_OK;
+}
 
 /* the method's timers and the terms, in that order; with `since`, the
  * seconds spent after that snapshot (set-up work excluded) */
@@ -207,38 +203,41 @@ static void bench_child(const bench_case *c, int threads, const char *dir,
   size_t n = 0;
   for (int i = 0; i < BENCH_MAX_SETS && c->sets[i]; ++i)
     sets[n++] = c->sets[i];
-  const char *const *extra = c->frame ? outputs_frame : outputs_off;
+  const char *const *extra = c->frame ? outputs_frame : sph_bench_outputs_off;
   size_t nextra = c->frame ? sizeof outputs_frame / sizeof *outputs_frame
-                           : sizeof outputs_off / sizeof *outputs_off;
+                           : SPH_BENCH_OUTPUTS_OFF;
   for (size_t i = 0; i < nextra; ++i)
     sets[n++] = extra[i];
   char path[1024];
   snprintf(path, sizeof path, "%s/%s.yaml", sph_app_scenes_dir(), c->scene);
   sph_scene *scene = NULL;
+  sph_run *run = NULL;
   sph_sim *sim = NULL;
   sph_error err;
   sph_error_clear(&err);
   double t0 = sph_wtime();
   sph_status st = sph_scene_load(&scene, path, sets, n, &err);
+  sph_run_options opt = {.no_files = 1};
   if (st == SPH_OK)
-    st = sph_sim_create(&sim, scene, &err);
+    st = sph_run_create(&run, scene, &opt, &err);
   r->setup_seconds = sph_wtime() - t0;
   if (st == SPH_OK) {
+    sim = sph_run_sim(run);
     r->particles = (long)sim->ps->n;
     r->threads = sim->threads;
     /* the first step touches the work arrays' pages for the first time
      * (about 1 s at 1M particles): timed apart, so the case's figure is
      * the steady step rate a long run sees */
     t0 = sph_wtime();
-    st = sph_sim_step(sim, scene->t_end - sim->t, &err);
+    st = sph_bench_steps(run, 1, &err);
     r->first_step_seconds = sph_wtime() - t0;
     bench_result *before = calloc(1, sizeof *before);
     if (before)
       collect_parts(sim, before, NULL);
     double c0 = cpu_seconds();
     t0 = sph_wtime();
-    for (long k = 0; k < c->steps && st == SPH_OK; ++k)
-      st = sph_sim_step(sim, scene->t_end - sim->t, &err);
+    if (st == SPH_OK)
+      st = sph_bench_steps(run, (unsigned long)c->steps, &err);
     r->step_seconds = sph_wtime() - t0;
     r->step_cpu_seconds = cpu_seconds() - c0;
     r->steps = (long)sim->steps - 1;
@@ -252,7 +251,7 @@ static void bench_child(const bench_case *c, int threads, const char *dir,
   r->ok = st == SPH_OK;
   if (!r->ok)
     sph_error_format(&err, r->error, sizeof r->error);
-  sph_sim_destroy(sim);
+  sph_run_destroy(run);
   sph_scene_destroy(scene);
 }
 
@@ -440,7 +439,7 @@ static void print_row(const bench_case *c, const bench_result *r,
     printf("\n");
 }
 
-static void json_str(FILE *f, const char *s) {
+void sph_bench_json_str(FILE *f, const char *s) {
   fputc('"', f);
   for (; *s; ++s)
     if (*s == '"' || *s == '\\')
@@ -472,14 +471,14 @@ static void cpu_model(char *out, size_t len) {
 /* the JSON's opening: schema, suite and machine */
 /* the head and the machine; speed[0][t]: the memory bandwidth, speed[1][t]
  * the arithmetic rate on the bench's nthr thread counts (none: nthr 0) */
-static void json_head(FILE *f, const char *suite, long cores,
-                      const double speed[2][2], int nthr) {
+void sph_bench_json_head(FILE *f, const char *suite, long cores,
+                         const double speed[2][2], int nthr) {
   char cpu[256];
   cpu_model(cpu, sizeof cpu);
   fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
           BENCH_SCHEMA, suite);
   fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
-  json_str(f, cpu);
+  sph_bench_json_str(f, cpu);
   const char *keys[2] = {"triad_gb_per_s", "multiply_add_gflop_per_s"};
   for (int k = 0; k < 2 && nthr > 0; ++k) {
     fprintf(f, ", \"%s\": [", keys[k]);
@@ -491,7 +490,7 @@ static void json_head(FILE *f, const char *suite, long cores,
 }
 
 /* closes the JSON written to tmp and renames it to path; -1 on failure */
-static int json_finish(FILE *f, const char *tmp, const char *path) {
+int sph_bench_json_finish(FILE *f, const char *tmp, const char *path) {
   int bad = ferror(f) != 0;
   bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
   bad |= fclose(f) != 0;
@@ -510,18 +509,18 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
   FILE *f = fopen(tmp, "w");
   if (!f)
     return -1;
-  json_head(f, quick ? "quick" : "full", cores, speed, nthr);
+  sph_bench_json_head(f, quick ? "quick" : "full", cores, speed, nthr);
   fprintf(f, "  \"baseline_rss_mb\": %.3f,\n  \"cases\": [",
           baseline_kb / 1024.0);
   for (int c = 0; c < ncases; ++c)
     for (int t = 0; t < nthr; ++t) {
       const bench_result *r = &res[c * nthr + t];
       fprintf(f, "%s\n    {\"name\": ", c || t ? "," : "");
-      json_str(f, cases[c].name);
+      sph_bench_json_str(f, cases[c].name);
       fprintf(f, ", \"ok\": %s", r->ok ? "true" : "false");
       if (!r->ok) {
         fprintf(f, ", \"error\": ");
-        json_str(f, r->error);
+        sph_bench_json_str(f, r->error);
         fprintf(f, "}");
         continue;
       }
@@ -542,13 +541,13 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
       fprintf(f, ", \"parts\": {");
       for (int i = 0; i < r->nparts; ++i) {
         fprintf(f, "%s", i ? ", " : "");
-        json_str(f, r->part[i]);
+        sph_bench_json_str(f, r->part[i]);
         fprintf(f, ": %.6g", r->part_seconds[i]);
       }
       fprintf(f, "}}");
     }
   fprintf(f, "\n  ]\n}\n");
-  return json_finish(f, tmp, path);
+  return sph_bench_json_finish(f, tmp, path);
 }
 
 /* empties and removes the suite's own temporary folder (one level of
@@ -569,158 +568,6 @@ static void remove_dir_files(const char *dir) {
       closedir(d);
     rmdir(dirs[i]);
   }
-}
-
-/* --mpi: the tl-csph column at 202,771 particles, as docs/results.md's
- * 1 -> 2 rank scaling (full: 100 steps, quick: 10) */
-static const bench_case mpi_cases[2] = {
-    {"twisting column tl-csph over MPI ranks",
-     "twisting_column",
-     {"bodies.0.particles.count=[31,211,31]", "method={name: tl-csph}"},
-     100,
-     0},
-    {"twisting column tl-csph over MPI ranks",
-     "twisting_column",
-     {"bodies.0.particles.count=[31,211,31]", "method={name: tl-csph}"},
-     10,
-     0},
-};
-
-/* what --mpi measured (the slowest rank's times, the sums' traffic) */
-typedef struct mpi_result {
-  long particles, steps;
-  double setup, first, wall, comm, values, messages, rss_mb;
-  sph_halo halo;
-} mpi_result;
-
-/* the case on this process's rank; collective over the ranks */
-static sph_status mpi_measure(const bench_case *c, int weak, mpi_result *m,
-                              sph_error *err) {
-  const char *sets[BENCH_MAX_SETS + 8];
-  size_t n = 0;
-  for (int i = 0; i < BENCH_MAX_SETS && c->sets[i]; ++i)
-    sets[n++] = c->sets[i];
-  /* weak: 101,866 particles a rank, the column 3 m a rank tall at the
-   * strong case's spacing */
-  char count[64], height[64];
-  int R = sph_domain_world_size();
-  snprintf(count, sizeof count, "bodies.0.particles.count=[31,%d,31]",
-           105 * R + 1);
-  snprintf(height, sizeof height, "bodies.0.shape.box.max=[0.5,%d,0.5]", 3 * R);
-  if (weak) {
-    sets[0] = count;
-    sets[n++] = height;
-  }
-  for (size_t i = 0; i < sizeof outputs_off / sizeof *outputs_off; ++i)
-    sets[n++] = outputs_off[i];
-  char path[1024];
-  snprintf(path, sizeof path, "%s/%s.yaml", sph_app_scenes_dir(), c->scene);
-  sph_scene *scene = NULL;
-  sph_sim *sim = NULL;
-  double t0 = sph_wtime();
-  sph_status st = sph_scene_load(&scene, path, sets, n, err);
-  if (st == SPH_OK) /* errors before and in the partition: on every rank */
-    st = sph_sim_create(&sim, scene, err);
-  if (st == SPH_OK) {
-    sph_domain *d = sim->domain;
-    m->setup = sph_domain_max(d, sph_wtime() - t0);
-    t0 = sph_wtime(); /* first touch of the work arrays, timed apart */
-    st = sph_sim_step(sim, scene->t_end - sim->t, err);
-    m->first = sph_domain_max(d, sph_wtime() - t0);
-    double v0, k0, v1, k1, comm0 = sph_domain_seconds(d);
-    sph_domain_traffic(d, &v0, &k0);
-    t0 = sph_wtime();
-    for (long k = 0; k < c->steps && st == SPH_OK; ++k)
-      st = sph_sim_step(sim, scene->t_end - sim->t, err);
-    m->wall = sph_domain_max(d, sph_wtime() - t0);
-    m->comm = sph_domain_max(d, sph_domain_seconds(d) - comm0);
-    m->steps = c->steps;
-    sph_domain_traffic(d, &v1, &k1);
-    double sums[3] = {v1 - v0, k1 - k0, (double)sim->ps->n};
-    sph_domain_sum(d, sums, 3);
-    m->values = sums[0] / (double)c->steps;
-    m->messages = sums[1] / (double)c->steps;
-    m->particles = (long)sums[2];
-    m->halo = sph_domain_halo(d);
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    m->rss_mb = sph_domain_max(d, (double)ru.ru_maxrss / 1024.0);
-  }
-  sph_sim_destroy(sim);
-  sph_scene_destroy(scene);
-  return st;
-}
-
-static int mpi_json(const char *path, const bench_case *c, const mpi_result *m,
-                    int quick, int weak, int ranks, int threads) {
-  char tmp[1100];
-  snprintf(tmp, sizeof tmp, "%s.part", path);
-  FILE *f = fopen(tmp, "w");
-  if (!f)
-    return -1;
-  json_head(f, quick ? "mpi-quick" : "mpi", sysconf(_SC_NPROCESSORS_ONLN), NULL,
-            0);
-  fprintf(f, "  \"scaling\": \"%s\",\n  \"cases\": [\n    {\"name\": ",
-          weak ? "weak" : "strong");
-  json_str(f, c->name);
-  fprintf(f,
-          ", \"ok\": true, \"ranks\": %d, \"threads\": %d, "
-          "\"particles\": %ld, \"steps\": %ld, \"setup_seconds\": %.6g, "
-          "\"first_step_seconds\": %.6g, \"step_seconds\": %.6g, "
-          "\"particle_steps_per_second\": %.6g, "
-          "\"exchange_seconds\": %.6g, \"halo_values_per_step\": %.6g, "
-          "\"halo_messages_per_step\": %.6g, \"max_owned\": %.0f, "
-          "\"max_ghosts\": %.0f, \"peak_rss_mb_per_rank\": %.3f}\n  ]\n}\n",
-          ranks, threads, m->particles, m->steps, m->setup, m->first, m->wall,
-          (double)m->particles * (double)m->steps / m->wall, m->comm, m->values,
-          m->messages, m->halo.max_owned, m->halo.max_ghosts, m->rss_mb);
-  return json_finish(f, tmp, path);
-}
-
-/* sph bench --mpi: rank 0 prints and writes the JSON */
-static int bench_mpi(int quick, int weak, int threads, const char *json) {
-  const bench_case *c = &mpi_cases[quick];
-  int root = sph_domain_world_rank() == 0, ranks = sph_domain_world_size();
-  if (!root && !freopen("/dev/null", "w", stdout))
-    return SPH_EXIT_IO;
-  omp_set_num_threads(threads);
-  printf("sph bench --mpi (%s%s): %s, %ld steps on %d rank%s of %d "
-         "thread%s, %ld cores here\n",
-         quick ? "quick" : "full",
-         weak ? ", weak: 31 x (105 N + 1) x 31" : ", strong: 31 x 211 x 31",
-         c->name, c->steps, ranks, ranks == 1 ? " (no launcher)" : "s (MPI)",
-         threads, threads == 1 ? "" : "s", sysconf(_SC_NPROCESSORS_ONLN));
-  fflush(stdout);
-  mpi_result m;
-  memset(&m, 0, sizeof m);
-  sph_error err;
-  sph_error_clear(&err);
-  if (mpi_measure(c, weak, &m, &err) != SPH_OK) {
-    sph_app_print_error(&err);
-    return SPH_EXIT_FAIL;
-  }
-  double rate = (double)m.particles * (double)m.steps / m.wall;
-  printf("  %ld particles, %ld steps: %.3f s, %.4g particle-steps/s (%.4g a "
-         "rank); set-up %.2f s, first step %.3f s\n",
-         m.particles, m.steps, m.wall, rate, rate / ranks, m.setup, m.first);
-  if (ranks > 1)
-    printf("  halo: at most %.0f owned and %.0f ghost particles a rank; %.0f "
-           "values (%.0f kB) in %.0f messages per step\n",
-           m.halo.max_owned, m.halo.max_ghosts, m.values, 8e-3 * m.values,
-           m.messages);
-  printf("  exchanges and reductions: at most %.3f s of a rank's %.3f s "
-         "(%.1f %%, waits included); peak resident set %.0f MB a rank\n",
-         m.comm, m.wall, 100.0 * m.comm / m.wall, m.rss_mb);
-  if (ranks == 1)
-    printf("  no halo on one rank; over N ranks: mpirun -np N sph bench "
-           "--mpi%s (or srun)\n",
-           quick ? " --quick" : "");
-  int rc = SPH_EXIT_OK;
-  if (root && json && mpi_json(json, c, &m, quick, weak, ranks, threads) != 0) {
-    fprintf(stderr, "sph bench: cannot write %s\n", json);
-    rc = SPH_EXIT_IO;
-  }
-  return rc;
 }
 
 typedef struct bench_args {
@@ -765,6 +612,27 @@ static const sph_app_command bench_command = {
     "  --mpi --case weak: 101,866 particles a rank\n",
     bench_allowed, bench_option, NULL};
 
+/* the suite, or with --case the case of that name, else the cases whose
+ * name contains the text (none: a message); NULL without memory */
+static bench_case *select_cases(int quick, const char *only, int *ncases) {
+  const bench_case *suite = quick ? quick_cases : full_cases;
+  int nsuite = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
+                     : (int)(sizeof full_cases / sizeof *full_cases);
+  bench_case *cases = malloc((size_t)nsuite * sizeof *cases);
+  int exact = 0;
+  *ncases = 0;
+  for (int c = 0; only && c < nsuite; ++c)
+    exact |= !strcmp(suite[c].name, only);
+  for (int c = 0; cases && c < nsuite; ++c)
+    if (!only || (exact ? !strcmp(suite[c].name, only)
+                        : strstr(suite[c].name, only) != NULL))
+      cases[(*ncases)++] = suite[c];
+  if (cases && !*ncases)
+    fprintf(stderr, "sph bench: no case of the %s suite is named '%s'\n",
+            quick ? "quick" : "full", only);
+  return cases;
+}
+
 int sph_cmd_bench(int argc, char **argv) {
   bench_args b = {0, 0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
@@ -780,7 +648,7 @@ int sph_cmd_bench(int argc, char **argv) {
     return SPH_EXIT_USAGE;
   }
   if (b.mpi)
-    return bench_mpi(b.quick, weak, b.threads ? b.threads : 1, b.json);
+    return sph_bench_mpi(b.quick, weak, b.threads ? b.threads : 1, b.json);
   if (sph_domain_world_size() > 1) { /* forks a process per case */
     if (sph_domain_world_rank() == 0)
       fprintf(stderr, "sph bench: under mpirun only 'sph bench --mpi' "
@@ -789,23 +657,9 @@ int sph_cmd_bench(int argc, char **argv) {
   }
   int quick = b.quick, threads = b.threads;
   const char *json = b.json;
-  const bench_case *suite = quick ? quick_cases : full_cases;
-  int nsuite = quick ? (int)(sizeof quick_cases / sizeof *quick_cases)
-                     : (int)(sizeof full_cases / sizeof *full_cases);
-  /* the suite, or with --case the case of that name, else the cases whose
-   * name contains the text */
-  bench_case *cases = malloc((size_t)nsuite * sizeof *cases);
-  int ncases = 0, exact = 0;
-  for (int c = 0; b.only && c < nsuite; ++c)
-    exact |= !strcmp(suite[c].name, b.only);
-  for (int c = 0; cases && c < nsuite; ++c)
-    if (!b.only || (exact ? !strcmp(suite[c].name, b.only)
-                          : strstr(suite[c].name, b.only) != NULL))
-      cases[ncases++] = suite[c];
+  int ncases = 0;
+  bench_case *cases = select_cases(quick, b.only, &ncases);
   if (!cases || !ncases) {
-    if (cases)
-      fprintf(stderr, "sph bench: no case of the %s suite is named '%s'\n",
-              quick ? "quick" : "full", b.only);
     free(cases);
     return cases ? SPH_EXIT_USAGE : SPH_EXIT_IO;
   }

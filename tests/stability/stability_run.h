@@ -1,7 +1,7 @@
 /* The stability suites' driver: runs a shipped scene with overrides through
- * sph_sim_step and the verdict of include/sph/stability.h, observing every
- * `every` seconds as `sph run` does at its output times, and prints one
- * line of the measured indicators. */
+ * the run (src/solver/run.h, writing no files), its output frames every
+ * `every` seconds where the verdict observes them as at `sph run`'s output
+ * times, and prints one line of the measured indicators. */
 #ifndef SPH_STABILITY_RUN_H
 #define SPH_STABILITY_RUN_H
 
@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include "scene/scene.h"
+#include "solver/run.h"
 #include "solver/sim.h"
 #include "solver/stability.h"
 
@@ -37,6 +38,45 @@ typedef struct outcome {
 /* called at every observed frame, after method->derive */
 typedef void (*frame_hook)(sph_sim *sim, void *ctx);
 
+typedef struct frames_seen {
+  frame_hook hook;
+  void *ctx;
+  double sum; /* of the checkerboard indicator after the first frame */
+  int frames;
+} frames_seen;
+
+static inline void on_frame(sph_run *run, const sph_frame *fr, void *ctx) {
+  frames_seen *f = ctx;
+  if (f->hook)
+    f->hook(sph_run_sim(run), f->ctx);
+  if (f->frames++ > 0) /* the state at rest has no pressure to judge */
+    f->sum += sph_run_verdict(run)->checkerboard;
+}
+
+static inline void outcome_fill(outcome *o, const sph_verdict *v,
+                                const sph_sim *sim, const frames_seen *f) {
+  o->stable = v->stable;
+  o->nan = v->nan;
+  snprintf(o->reason, sizeof o->reason, "%s", v->reason);
+  o->t = sim->t;
+  o->t_tripped = v->stable ? NAN : v->t_tripped;
+  o->first = v->first;
+  memcpy(o->tripped_at, v->tripped_at, sizeof o->tripped_at);
+  o->cb_mean = f->frames > 1 ? f->sum / (f->frames - 1) : 0.0;
+  o->cb_max = v->checkerboard_max;
+  o->j_min = v->J_min;
+  o->e0 = v->energy0;
+  o->e1 = v->energy_final;
+  o->e_max = v->energy_max;
+  o->stretch_max = v->fracture_peak_stretch;
+  o->pairs_over = v->fracture_peak_over;
+  o->fracture_dp = v->fracture_dp;
+  o->zigzag_max = v->zigzag_max;
+  o->zigzag_end = v->zigzag;
+  o->zigzag_threshold = v->zigzag_threshold;
+  o->frames = v->frames;
+}
+
 /* runs scenes/<name>.yaml with overrides, observing every `every` s, to
  * the end time or, unless keep_going, the first indicator that trips */
 static inline outcome run_frames(const char *name, const char *const *sets,
@@ -47,64 +87,23 @@ static inline outcome run_frames(const char *name, const char *const *sets,
   struct timespec w0, w1;
   clock_gettime(CLOCK_MONOTONIC, &w0);
   sph_scene *s;
-  sph_sim *sim;
-  sph_verdict *v;
+  sph_run *run;
   sph_error err;
   ck_assert_msg(sph_scene_load(&s, path, sets, nsets, &err) == SPH_OK, "%s",
                 err.message);
-  ck_assert_msg(sph_sim_create(&sim, s, &err) == SPH_OK, "%s", err.message);
-  ck_assert(sph_verdict_create(&v, sim, &err) == SPH_OK);
-  outcome o = {0};
-  double sum = 0.0;
-  int frames = 0;
-  int failed = 0;
-  for (int k = 0; v->stable || keep_going; ++k) {
-    double next = fmin(s->t_end, every * k);
-    while (sim->t < next - 1e-12 * s->t_end) {
-      if (sph_sim_step(sim, next - sim->t, &err) != SPH_OK) {
-        sph_verdict_fail_step(v, sim->t, &err);
-        failed = 1;
-        break;
-      }
-    }
-    if (failed || !(v->stable || keep_going))
-      break;
-    ck_assert(sim->method->derive(sim, &err) == SPH_OK);
-    sph_frame fr = {.time = sim->t, .sim = sim, .ps = sim->ps};
-    sim->method->energy(sim, &fr.kinetic, &fr.strain);
-    ck_assert_msg(sph_verdict_observe(v, &fr, &err) == SPH_OK, "%s",
-                  err.message);
-    if (hook)
-      hook(sim, ctx);
-    if (frames++ > 0) /* the state at rest has no pressure to judge */
-      sum += v->checkerboard;
-    if (next >= s->t_end)
-      break;
-  }
+  frames_seen f = {hook, ctx, 0.0, 0};
+  sph_run_options opt = {.no_files = 1};
+  sph_run_hooks hooks = {
+      .ctx = &f, .frame = on_frame, .every = every, .keep_going = keep_going};
+  ck_assert_msg(sph_run_create_hooked(&run, s, &opt, &hooks, &err) == SPH_OK,
+                "%s", err.message);
+  ck_assert_msg(sph_run_advance(run, sph_scene_end_time(s), &err) == SPH_OK,
+                "%s", err.message);
   clock_gettime(CLOCK_MONOTONIC, &w1);
-  o.stable = v->stable;
-  o.nan = v->nan;
-  snprintf(o.reason, sizeof o.reason, "%s", v->reason);
-  o.t = sim->t;
-  o.t_tripped = v->stable ? NAN : v->t_tripped;
-  o.first = v->first;
-  memcpy(o.tripped_at, v->tripped_at, sizeof o.tripped_at);
-  o.cb_mean = frames > 1 ? sum / (frames - 1) : 0.0;
-  o.cb_max = v->checkerboard_max;
-  o.j_min = v->J_min;
-  o.e0 = v->energy0;
-  o.e1 = v->energy_final;
-  o.e_max = v->energy_max;
-  o.stretch_max = v->fracture_peak_stretch;
-  o.pairs_over = v->fracture_peak_over;
-  o.fracture_dp = v->fracture_dp;
-  o.zigzag_max = v->zigzag_max;
-  o.zigzag_end = v->zigzag;
-  o.zigzag_threshold = v->zigzag_threshold;
-  o.frames = v->frames;
+  outcome o = {0};
+  outcome_fill(&o, sph_run_verdict(run), sph_run_sim(run), &f);
   o.wall = (double)(w1.tv_sec - w0.tv_sec) + 1e-9 * (w1.tv_nsec - w0.tv_nsec);
-  sph_verdict_destroy(v);
-  sph_sim_destroy(sim);
+  sph_run_destroy(run);
   sph_scene_destroy(s);
   return o;
 }
