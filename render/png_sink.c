@@ -46,6 +46,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "gl_impl.h"
 #include "io/vtk_read.h"
@@ -875,6 +876,13 @@ static sph_status png_open_sync(sph_sink *sink, const sph_sim *sim,
   return png_open_as(sink, sim, dir, 0, err);
 }
 
+/* a render thread only where a core is left for it */
+static sph_status png_open_auto(sph_sink *sink, const sph_sim *sim,
+                                const char *dir, sph_error *err) {
+  long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  return png_open_as(sink, sim, dir, sim->threads < cores, err);
+}
+
 /* The box of m positions (lo > hi when m is 0). */
 static void png_box(const float *xyz, size_t m, double lo[3], double hi[3]) {
   for (int k = 0; k < 3; ++k) {
@@ -1233,8 +1241,25 @@ static void png_destroy(sph_sink *sink) {
   sink->data = NULL;
 }
 
+static int png_enabled(const sph_scene *scene) {
+  return scene->output.png.enabled;
+}
+
 const sph_sink_ops sph_png_sink_ops = {
     .name = "png",
+    .enabled = png_enabled,
+    .distributed = 1,
+    .open = png_open_auto,
+    .write = png_write,
+    .flush = png_flush,
+    .close = png_close,
+    .destroy = png_destroy,
+};
+
+const sph_sink_ops sph_png_sink_thread_ops = {
+    .name = "png",
+    .enabled = png_enabled,
+    .distributed = 1,
     .open = png_open,
     .write = png_write,
     .flush = png_flush,
@@ -1244,6 +1269,8 @@ const sph_sink_ops sph_png_sink_ops = {
 
 const sph_sink_ops sph_png_sink_sync_ops = {
     .name = "png",
+    .enabled = png_enabled,
+    .distributed = 1,
     .open = png_open_sync,
     .write = png_write,
     .flush = png_flush,

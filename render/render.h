@@ -9,12 +9,16 @@
 #include "solver/sim.h"
 #include "sph/status.h"
 
+/* The png sink of the registry (io/sink_list.h): sph_png_sink_thread_ops
+ * where the run's OpenMP team leaves a core free, sph_png_sink_sync_ops
+ * where it takes every core. */
+extern const sph_sink_ops sph_png_sink_ops;
 /* Renders and writes each frame on a render thread of its own: `write`
  * copies what the frame needs and returns (waiting only while the frame
  * before is still rendering), `flush` and `close` wait until every frame is
  * written, and a render thread error comes back from the next of them;
  * thread_seconds is that thread's busy time. */
-extern const sph_sink_ops sph_png_sink_ops;
+extern const sph_sink_ops sph_png_sink_thread_ops;
 /* The same frames, each drawn, composited and written inside `write` on
  * the calling thread: for runs whose OpenMP team already takes every core,
  * where a render thread would compete with it (and with spinning OpenMP

@@ -28,7 +28,7 @@ extern "C" {
 SPH_API const char *sph_version(void);
 
 /* --- scenes ----------------------------------------------------------------
- * A scene is a YAML file (scenes/*.yaml, docs/scenes.md). `sets` are
+ * A scene is a YAML file (scenes/NAME.yaml, docs/scenes.md). `sets` are
  * overrides "key.path=value" applied in order, as `sph run --set` does (the
  * value is YAML: "time.end=0.01", "method={name: tl-bond}"). A shipped
  * scene's name ("twisting_column") is found in the installed scenes folder
@@ -61,11 +61,13 @@ typedef struct sph_run_options {
   int resume;
   /* OpenMP threads (0: the library's default) */
   int threads;
-  /* 1: no start-up banner and no progress line on stdout */
+  /* 1: no start-up banner and no progress line on stdout (the library
+   * itself never prints: sph run prints them unless --quiet) */
   int quiet;
   /* polled between steps: non-zero asks the run to stop at the next step
    * boundary with outputs finished and a checkpoint written (a signal
-   * handler sets it; NULL: never) */
+   * handler sets it to the signal's number, which summary.json names in
+   * stopped_by; NULL: never). Over MPI ranks the ranks agree on it. */
   const volatile int *stop;
   /* 1: write nothing (no folder, sinks, checkpoints or summary.json): the
    * run is only stepped and judged, as `sph bench` and the tests do */
@@ -82,9 +84,13 @@ SPH_API sph_status sph_run_create(sph_run **out, const sph_scene *scene,
                                   sph_error *err);
 
 /* Advances to t_until (s), clamped to the scene's end time, through every
- * output time on the way. Returns SPH_OK also when the verdict turned
- * unstable or a stop was requested (the run then stays where it stopped:
- * sph_run_state says why). */
+ * output time on the way: to the first step boundary at or after t_until,
+ * exactly on it when it is an output time (the steps keep to the scene's
+ * output times, so the outputs do not depend on how a run is advanced).
+ * Returns SPH_OK also when the verdict turned unstable (a step that failed
+ * trips its `step` indicator) or a stop was requested (the run then stays
+ * where it stopped: sph_run_state_of says why); an output that failed is
+ * SPH_ERR_IO and SPH_RUN_FAILED. */
 SPH_API sph_status sph_run_advance(sph_run *run, double t_until,
                                    sph_error *err);
 
@@ -103,7 +109,8 @@ SPH_API unsigned long sph_run_steps(const sph_run *run); /* steps so far */
 /* --- fields ----------------------------------------------------------------
  * The particle fields of the current state of this process's particles
  * (over MPI ranks: its owned ones), as arrays of n * components doubles,
- * particle-major, valid until the next advance or close. Derived fields
+ * particle-major, in the run's storage order ("id" is each particle's
+ * creation index), valid until the next advance or close. Derived fields
  * (pressure, von Mises, J, displacement) are refreshed on demand. Names and
  * units are those of docs/outputs.md: "position" (m, 3), "velocity" (m/s,
  * 3), "displacement" (m, 3), "pressure" (Pa, 1; positive in compression),

@@ -80,8 +80,12 @@ static sph_status energy_write(sph_sink *sink, const sph_frame *fr,
   return sph_stream_row_end(af, err);
 }
 
+static int energy_enabled(const sph_scene *scene) { return 1; }
+
 const sph_sink_ops sph_energy_sink_ops = {
     .name = "energy.csv",
+    .enabled = energy_enabled,
+    .distributed = 0,
     .open = energy_open,
     .write = energy_write,
     .flush = csv_flush,
@@ -176,8 +180,14 @@ static void probe_destroy(sph_sink *sink) {
   sink->data = NULL;
 }
 
+static int probe_enabled(const sph_scene *scene) {
+  return scene->output.nprobes > 0;
+}
+
 const sph_sink_ops sph_probe_sink_ops = {
     .name = "probes.csv",
+    .enabled = probe_enabled,
+    .distributed = 0,
     .open = probe_open,
     .write = probe_write,
     .flush = csv_flush,

@@ -22,8 +22,15 @@ typedef struct sph_frame {
 } sph_frame;
 
 typedef struct sph_sink sph_sink;
+/* A sink's ops; every sink is listed once in io/sink_list.h (the registry,
+ * sph_sink_list), in the order the run opens and writes them. */
 typedef struct sph_sink_ops {
-  const char *name;
+  const char *name; /* as in summary.json's "sinks" */
+  /* the scene asks for this sink's files */
+  int (*enabled)(const sph_scene *scene);
+  /* over MPI ranks, 1: every rank writes its piece (collective hooks);
+   * 0: rank 0 writes the whole run's view */
+  int distributed;
   sph_status (*open)(sph_sink *sink, const sph_sim *sim, const char *dir,
                      sph_error *err);
   sph_status (*write)(sph_sink *sink, const sph_frame *frame, sph_error *err);
@@ -55,6 +62,9 @@ extern const sph_sink_ops sph_energy_sink_ops;
 extern const sph_sink_ops sph_probe_sink_ops;
 /* <scene>_NNNN.vtp per output time and <scene>.pvd (ParaView) */
 extern const sph_sink_ops sph_vtk_sink_ops;
+
+/* Every sink of io/sink_list.h, in its order, NULL-terminated. */
+const sph_sink_ops *const *sph_sink_list(void);
 
 /* Files written under a temporary name, fsync'd and renamed on commit. */
 typedef struct sph_atomic_file {

@@ -391,8 +391,12 @@ static void vtk_destroy(sph_sink *sink) {
   sink->data = NULL;
 }
 
+static int vtk_enabled(const sph_scene *scene) { return scene->output.vtk; }
+
 const sph_sink_ops sph_vtk_sink_ops = {
     .name = "vtk",
+    .enabled = vtk_enabled,
+    .distributed = 1,
     .open = vtk_open,
     .write = vtk_write,
     .close = vtk_close,

@@ -69,7 +69,7 @@ static void open_async(sph_sink *sink, const char *name, sph_scene **scene,
   make_sim(NULL, 0, scene, sim);
   snprintf(out, sizeof out, "%s/%s", dir, name);
   snprintf(frames, size, "%s/frames", out);
-  open_sink(sink, &sph_png_sink_ops, *sim, out);
+  open_sink(sink, &sph_png_sink_thread_ops, *sim, out);
 }
 
 static unsigned char *slurp(const char *path, long *len) {
@@ -112,7 +112,7 @@ static void compare_run(const char *tag, const char *const *extra,
   snprintf(a, sizeof a, "%s/%s_thread", dir, tag);
   snprintf(b, sizeof b, "%s/%s_sync", dir, tag);
   sph_sink async, sync;
-  open_sink(&async, &sph_png_sink_ops, sim, a);
+  open_sink(&async, &sph_png_sink_thread_ops, sim, a);
   open_sink(&sync, &sph_png_sink_sync_ops, sim, b);
   sph_error err;
   double *saved = malloc(3 * sim->ps->n * sizeof *saved);
