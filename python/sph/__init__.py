@@ -18,8 +18,9 @@ to libsph.so), then beside the installed package, then by the system
 loader. docs/python.md describes the API.
 """
 
-import json
 import ctypes
+import json
+import signal
 import weakref
 from collections import namedtuple
 from dataclasses import dataclass
@@ -235,10 +236,12 @@ class Run:
         _check(self._lib, st, err)
         return self.state
 
-    def request_stop(self):
+    def request_stop(self, signo=signal.SIGTERM):
         """Asks a running advance() (in another thread) to stop at the next
-        step boundary with its outputs finished and a checkpoint written."""
-        self._stop.value = 1
+        step boundary with its outputs finished and a checkpoint written;
+        the run's state becomes "stopped" and summary.json's stopped_by
+        names the signal `signo` as if it had been sent."""
+        self._stop.value = int(signo)
 
     # --- fields ----------------------------------------------------------
     def field(self, name, copy=False):
@@ -350,7 +353,8 @@ def load(scene, set=None, out=None, threads=0, overwrite=False, quiet=True, no_f
     """Loads a scene and sets its run up (the output frame at t = 0 is
     written); returns a Run.
 
-    scene: a YAML file's path or a shipped scene's name ("twisting_column").
+    scene: a YAML file's path or a shipped scene's name ("twisting_column",
+    looked for in $SPH_SCENES_DIR, the installed scenes, the source tree's).
     set: overrides as `sph run --set` takes them, a dict {"time.end": 0.01,
     "method": {"name": "tl-bond"}} (values written as YAML/JSON) or a list
     of "key=value" strings, applied in order. out: the output folder (None:
@@ -367,7 +371,8 @@ def load(scene, set=None, out=None, threads=0, overwrite=False, quiet=True, no_f
     sets = [s.encode() for s in _sets(set)]
     arr = (ctypes.c_char_p * max(len(sets), 1))(*sets)
     sc = ctypes.c_void_p()
-    st = lib.sph_scene_load(ctypes.byref(sc), str(scene).encode(), arr, len(sets), ctypes.byref(err))
+    path = _capi.scene_path(scene)
+    st = lib.sph_scene_load(ctypes.byref(sc), path.encode(), arr, len(sets), ctypes.byref(err))
     _check(lib, st, err)
     stop = ctypes.c_int(0)
     out_dir = None if out is None else ctypes.create_string_buffer(str(out).encode())

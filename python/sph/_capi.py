@@ -117,6 +117,39 @@ _PROTOTYPES = {
 _lib = None
 
 
+def scenes_dirs():
+    """Where shipped scenes are looked for by name: $SPH_SCENES_DIR, the
+    scenes installed with the package, the source tree's scenes/."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    dirs = []
+    if os.environ.get("SPH_SCENES_DIR"):
+        dirs.append(os.environ["SPH_SCENES_DIR"])
+    try:
+        from . import _install
+
+        dirs.append(os.path.normpath(os.path.join(here, _install.SCENES)))
+    except ImportError:
+        pass
+    dirs.append(os.path.normpath(os.path.join(here, "..", "..", "scenes")))
+    return dirs
+
+
+def scene_path(scene):
+    """A scene argument as a path: an existing file or anything with a
+    slash as it is, else a shipped scene's name ("punch", "punch.yaml")
+    found in scenes_dirs(); unknown names are returned as they are (the
+    loader then reports the missing file)."""
+    scene = os.fspath(scene)
+    if os.path.exists(scene) or "/" in scene:
+        return scene
+    name = scene if scene.endswith(".yaml") else scene + ".yaml"
+    for d in scenes_dirs():
+        path = os.path.join(d, name)
+        if os.path.isfile(path):
+            return path
+    return scene
+
+
 def _candidates():
     env = os.environ.get("SPH_LIBRARY")
     if env:
