@@ -153,3 +153,15 @@ def test_unsupported_field(scenes):
         with pytest.raises(sph.Error) as e:
             run.field("temperature")
         assert e.value.code != 0
+
+
+def test_request_stop(scenes):
+    # a stop asked before advancing: the run stops at the first step
+    # boundary, stays there, and closes as stopped
+    with column(scenes, no_files=True) as run:
+        run.request_stop()
+        assert run.advance() == "stopped"
+        assert run.time < run.end_time
+        t = run.time
+        assert run.advance() == "stopped" and run.time == t
+    assert run.summary.state == "stopped"
