@@ -54,6 +54,9 @@ def test_fields_at_rest_lattice(scenes):
             assert a.shape == ((N, 3) if sph.FIELDS[name] == 3 else (N,)), name
             assert np.all(np.isfinite(a)), name
             assert not a.flags.writeable
+        # views of the library's arrays, not copies
+        assert np.shares_memory(f["position"], run.field("position"))
+        assert not np.shares_memory(f["position"], run.field("position", copy=True))
         # t = 0: the particles on the scene's lattice, undeformed (J = 1, no
         # displacement, no pressure), one body
         np.testing.assert_allclose(rows(f["position"]), lattice(), atol=1e-12)
