@@ -18,6 +18,8 @@ packages=(
   libfreetype-dev fonts-dejavu-core  # text on frames
   libfontconfig-dev # the frames' font found through fontconfig
   python3-vtk9      # VTK's own reader validates the files we write (tests)
+  python3-numpy     # the sph Python package's field arrays (python/sph)
+  python3-pytest    # the Python package's tests (tests/python)
   clang-format      # formatting is a test
   gnuplot-nox       # sph study figures (pngcairo)
   libopenmpi-dev openmpi-bin  # distributed runs (mpirun -np N sph run)

@@ -9,6 +9,14 @@
 #include <stdarg.h>
 #include <stddef.h>
 
+/* Marks a function libsph.so exports (the library is built with hidden
+ * visibility; tests/lib/check_exports.sh holds the exports to this list). */
+#if defined(__GNUC__)
+#define SPH_API __attribute__((visibility("default")))
+#else
+#define SPH_API
+#endif
+
 #define SPH_STATUS_LIST(X)                                                     \
   X(SPH_OK, "ok")                                                              \
   X(SPH_ERR_NOMEM, "out of memory")                                            \
@@ -43,33 +51,35 @@ typedef struct sph_error {
   char message[768];
 } sph_error;
 
-const char *sph_status_message(sph_status code);
-const char *sph_status_name(sph_status code);
+SPH_API const char *sph_status_message(sph_status code);
+SPH_API const char *sph_status_name(sph_status code);
 
 /* Clears the record (code SPH_OK, empty strings). Accepts NULL. */
-void sph_error_clear(sph_error *err);
+SPH_API void sph_error_clear(sph_error *err);
 
 /* Fills the record and returns `code`; printf-style message. Accepts NULL. */
-sph_status sph_error_set(sph_error *err, sph_status code, const char *fmt, ...)
+SPH_API sph_status sph_error_set(sph_error *err, sph_status code,
+                                 const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
 /* As sph_error_set, with an input location and key (a key path too long
  * for the record shortened by sph_key_path_fit). A message too long for
  * the record is cut at a word or key boundary and ends with an ellipsis. */
-sph_status sph_error_at(sph_error *err, sph_status code, const char *file,
-                        int line, int col, const char *key, const char *fmt,
-                        ...) __attribute__((format(printf, 7, 8)));
+SPH_API sph_status sph_error_at(sph_error *err, sph_status code,
+                                const char *file, int line, int col,
+                                const char *key, const char *fmt, ...)
+    __attribute__((format(printf, 7, 8)));
 
 /* Copies the key path `path` ("bodies[0].shape.box.min") into dst; one
  * too long is shortened at token boundaries (a key or an [index]), the
  * tokens left out shown as one ellipsis: "bodies.…[3].at". Never cuts a
  * token. NULL copies "". */
-void sph_key_path_fit(char *dst, size_t size, const char *path);
+SPH_API void sph_key_path_fit(char *dst, size_t size, const char *path);
 
 /* sph_error_at with a va_list. */
-sph_status sph_error_atv(sph_error *err, sph_status code, const char *file,
-                         int line, int col, const char *key, const char *fmt,
-                         va_list ap);
+SPH_API sph_status sph_error_atv(sph_error *err, sph_status code,
+                                 const char *file, int line, int col,
+                                 const char *key, const char *fmt, va_list ap);
 
 /* Returns from the calling function when `expr` is not SPH_OK. */
 #define SPH_TRY(expr)                                                          \
@@ -80,6 +90,6 @@ sph_status sph_error_atv(sph_error *err, sph_status code, const char *file,
   } while (0)
 
 /* Writes "file:line:col: key: message" (parts present only) into buf. */
-void sph_error_format(const sph_error *err, char *buf, size_t size);
+SPH_API void sph_error_format(const sph_error *err, char *buf, size_t size);
 
 #endif

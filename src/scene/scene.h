@@ -221,11 +221,12 @@ typedef struct sph_scene {
   double memory_limit;
 } sph_scene;
 
-/* Loads and validates `path`, after applying `nset` overrides "a.b=value". */
-sph_status sph_scene_load(sph_scene **out, const char *path,
-                          const char *const *overrides, size_t nset,
-                          sph_error *err);
-void sph_scene_destroy(sph_scene *s);
+/* Loads and validates `path`, after applying `nset` overrides "a.b=value".
+ * Both are public (include/sph/sph.h): exported from libsph.so. */
+SPH_API sph_status sph_scene_load(sph_scene **out, const char *path,
+                                  const char *const *overrides, size_t nset,
+                                  sph_error *err);
+SPH_API void sph_scene_destroy(sph_scene *s);
 
 /* Generates the particles of every body (POSITION0, VOLUME0, VELOCITY
  * allocated and filled; flags marked for boundary selections) and checks
