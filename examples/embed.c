@@ -3,7 +3,7 @@
  * largest displacement from the particle fields, then close the run (its
  * outputs finished, summary.json written) and print the verdict.
  *
- *   cc embed.c $(pkg-config --cflags --libs sph) -o embed
+ *   cc embed.c $(pkg-config --cflags --libs sph) -lm -o embed
  *   ./embed SCENE [key=value]...       (outputs in the current folder)    */
 #include <math.h>
 #include <stdio.h>

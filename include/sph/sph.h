@@ -51,6 +51,9 @@ SPH_API double sph_scene_end_time(const sph_scene *scene);
  * summary.json. `sph run` is this loop with a command line around it. */
 typedef struct sph_run sph_run;
 
+/* The stop flag's value for a stop that no signal asked for. */
+#define SPH_STOP_REQUEST 256
+
 typedef struct sph_run_options {
   /* output folder: NULL writes outputs/<scene name>; made if missing */
   const char *out_dir;
@@ -67,7 +70,8 @@ typedef struct sph_run_options {
   /* polled between steps: non-zero asks the run to stop at the next step
    * boundary with outputs finished and a checkpoint written (a signal
    * handler sets it to the signal's number, which summary.json names in
-   * stopped_by; NULL: never). Over MPI ranks the ranks agree on it. */
+   * stopped_by; SPH_STOP_REQUEST: a request that is no signal; NULL:
+   * never). Over MPI ranks the ranks agree on it. */
   const volatile int *stop;
   /* 1: write nothing (no folder, sinks, checkpoints or summary.json): the
    * run is only stepped and judged, as `sph bench` and the tests do */
@@ -113,9 +117,9 @@ SPH_API unsigned long sph_run_steps(const sph_run *run); /* steps so far */
  * creation index), valid until the next advance or close. Derived fields
  * (pressure, von Mises, J, displacement) are refreshed on demand. Names and
  * units are those of docs/outputs.md: "position" (m, 3), "velocity" (m/s,
- * 3), "displacement" (m, 3), "pressure" (Pa, 1; positive in compression),
- * "von_mises" (Pa, 1), "J" (1, det F), "body" (body index, 1), "id" (1). A
- * field the method does not fill is SPH_ERR_UNSUPPORTED. */
+ * 3), "displacement" (m, 3), "pressure" (Pa, 1; tr(sigma)/3, positive in
+ * tension), "von_mises" (Pa, 1), "J" (1, det F), "body" (body index, 1), "id"
+ * (1). A field the method does not fill is SPH_ERR_UNSUPPORTED. */
 SPH_API size_t sph_run_particles(const sph_run *run);
 SPH_API sph_status sph_run_field(sph_run *run, const char *name,
                                  const double **data, int *components,

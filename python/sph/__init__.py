@@ -20,7 +20,6 @@ loader. docs/python.md describes the API.
 
 import ctypes
 import json
-import signal
 import weakref
 from collections import namedtuple
 from dataclasses import dataclass
@@ -32,6 +31,9 @@ from . import _capi
 __all__ = ["load", "Run", "Summary", "Energy", "Error", "version", "FIELDS"]
 
 # the fields of docs/outputs.md: name -> components (1: an array of shape (n,))
+# the stop flag's value for a stop no signal asked for (SPH_STOP_REQUEST)
+STOP_REQUEST = 256
+
 FIELDS = {
     "position": 3,
     "velocity": 3,
@@ -236,12 +238,13 @@ class Run:
         _check(self._lib, st, err)
         return self.state
 
-    def request_stop(self, signo=signal.SIGTERM):
+    def request_stop(self, signo=None):
         """Asks a running advance() (in another thread) to stop at the next
         step boundary with its outputs finished and a checkpoint written;
-        the run's state becomes "stopped" and summary.json's stopped_by
-        names the signal `signo` as if it had been sent."""
-        self._stop.value = int(signo)
+        the run's state becomes "stopped". summary.json's stopped_by says
+        "request", or names the signal `signo` when one is given (a handler
+        that forwards a signal)."""
+        self._stop.value = int(signo) if signo else STOP_REQUEST
 
     # --- fields ----------------------------------------------------------
     def field(self, name, copy=False):

@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 
+#include "solver/run.h"
 #include "sph/status.h"
 
 #define SPH_EXIT_OK 0
@@ -108,13 +109,6 @@ sph_status sph_app_check_scene(const char *path, const char *const *sets,
 /* Parses run's and check's argv into args; returns 0, 2 or SPH_APP_HELP. */
 int sph_app_parse_args(int argc, char **argv, sph_app_args *args,
                        const sph_app_command *cmd);
-
-/* mkdir -p: 0, or -1 with errno set */
-int sph_app_mkdir_p(const char *path);
-/* An output folder made when missing (parents too) and tried by writing a
- * file in it: SPH_OK, or SPH_ERR_ARG (exit 2) naming the folder, the same
- * whether it cannot be made or exists and cannot be written in. */
-sph_status sph_app_output_dir(const char *dir, sph_error *err);
 
 /* The shipped scenes folder and the default scene. */
 const char *sph_app_scenes_dir(void);

@@ -275,7 +275,7 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
       snprintf(j.out, sizeof j.out, "%s", a->out);
     else
       snprintf(j.out, sizeof j.out, "%s/render", j.dir);
-    st = sph_app_output_dir(j.out, err);
+    st = sph_run_output_dir(j.out, err);
   }
   if (st == SPH_OK)
     st = render_frames(&j, frames, err);

@@ -458,13 +458,13 @@ static int run_study(study *s, study_args *a) {
     }
   }
   sph_error derr;
-  if (sph_app_output_dir(s->dir, &derr) != SPH_OK) {
+  if (sph_run_output_dir(s->dir, &derr) != SPH_OK) {
     sph_app_print_error(&derr);
     return SPH_EXIT_USAGE;
   }
   char runs[1100];
   snprintf(runs, sizeof runs, "%s/runs", s->dir);
-  if (sph_app_mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {
+  if (sph_mkdir_p(runs) != 0 || start_csv(s, csv) != 0) {
     fprintf(stderr, "sph study: cannot write %s: %s\n", s->dir,
             strerror(errno));
     return SPH_EXIT_IO;
@@ -484,7 +484,7 @@ static int run_study(study *s, study_args *a) {
       continue;
     char rundir[1200];
     snprintf(rundir, sizeof rundir, "%s/%03d", runs, c->index);
-    if (sph_app_mkdir_p(rundir) != 0) {
+    if (sph_mkdir_p(rundir) != 0) {
       fprintf(stderr, "sph study: cannot create %s: %s\n", rundir,
               strerror(errno));
       return SPH_EXIT_IO;

@@ -162,43 +162,6 @@ void sph_app_print_error(const sph_error *err) {
   fprintf(stderr, "sph: %s\n", buf);
 }
 
-int sph_app_mkdir_p(const char *path) {
-  char buf[1024];
-  snprintf(buf, sizeof buf, "%s", path);
-  for (char *p = buf + 1; *p; ++p)
-    if (*p == '/') {
-      *p = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return -1;
-      *p = '/';
-    }
-  return mkdir(buf, 0777) != 0 && errno != EEXIST ? -1 : 0;
-}
-
-sph_status sph_app_output_dir(const char *dir, sph_error *err) {
-  struct stat st;
-  if (sph_app_mkdir_p(dir) != 0 || stat(dir, &st) != 0)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "cannot create the output folder %s: %s", dir,
-                         strerror(errno));
-  if (!S_ISDIR(st.st_mode))
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "cannot create the output folder %s: a file of that "
-                         "name exists",
-                         dir);
-  /* permissions do not stop root: a file made and removed again tells */
-  char probe[1100];
-  snprintf(probe, sizeof probe, "%s/.sph-probe-XXXXXX", dir);
-  int fd = mkstemp(probe);
-  if (fd < 0)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         "cannot write in the output folder %s: %s", dir,
-                         strerror(errno));
-  close(fd);
-  unlink(probe);
-  return SPH_OK;
-}
-
 static int args_option(void *ctx, int id, const char *val) {
   sph_app_args *args = ctx;
   switch (id) {

@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "scene/expr.h"
 #include "scene/schema_impl.h"
@@ -201,10 +202,33 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   return SPH_OK;
 }
 
+/* A shipped scene's name ("punch" or "punch.yaml") that is no file here:
+ * $SPH_SCENES_DIR's, the installed one, the source tree's; anything else is
+ * returned as given (the loader then says what is wrong). */
+static const char *scene_find(const char *path, char *buf, size_t size) {
+  struct stat st;
+  if (!*path || strchr(path, '/') || stat(path, &st) == 0)
+    return path;
+  const char *env = getenv("SPH_SCENES_DIR");
+  const char *dirs[] = {env && *env ? env : NULL, SPH_SCENES_INSTALLED,
+                        SPH_SCENES_SOURCE};
+  size_t len = strlen(path);
+  int ext = len > 5 && !strcmp(path + len - 5, ".yaml");
+  for (int i = 0; i < 3; ++i)
+    if (dirs[i] &&
+        snprintf(buf, size, "%s/%s%s", dirs[i], path, ext ? "" : ".yaml") <
+            (int)size &&
+        stat(buf, &st) == 0 && S_ISREG(st.st_mode))
+      return buf;
+  return path;
+}
+
 sph_status sph_scene_load(sph_scene **out, const char *path,
                           const char *const *overrides, size_t nset,
                           sph_error *err) {
   *out = NULL;
+  char found[sizeof((sph_scene *)0)->path];
+  path = scene_find(path, found, sizeof found);
   sph_scene *s = calloc(1, sizeof *s);
   if (!s)
     return sph_error_set(err, SPH_ERR_NOMEM, "scene");

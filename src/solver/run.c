@@ -19,10 +19,6 @@
 #include "io/checkpoint.h"
 #include "solver/run_impl.h"
 
-/* An output folder made when missing (parents too) and tried by writing a
- * file in it; SPH_ERR_ARG naming it otherwise. */
-sph_status sph_run_output_dir(const char *dir, sph_error *err);
-
 static double run_eps(const sph_run *run) { return 1e-12 * run->scene->t_end; }
 
 /* the output frame `index`'s time: the scene's, or every hooks.every s */
@@ -404,12 +400,13 @@ sph_status sph_run_create_hooked(sph_run **out, const sph_scene *scene,
 }
 
 static const char *signal_name(int signo) {
-  return signo == SIGINT    ? "SIGINT"
-         : signo == SIGTERM ? "SIGTERM"
-         : signo == SIGHUP  ? "SIGHUP"
-         : signo == SIGUSR1 ? "SIGUSR1"
-         : signo < 0        ? "sph_run_close"
-                            : "a signal";
+  return signo == SIGINT             ? "SIGINT"
+         : signo == SIGTERM          ? "SIGTERM"
+         : signo == SIGHUP           ? "SIGHUP"
+         : signo == SIGUSR1          ? "SIGUSR1"
+         : signo < 0                 ? "sph_run_close"
+         : signo == SPH_STOP_REQUEST ? "request"
+                                     : "a signal";
 }
 
 sph_run_state sph_run_state_of(const sph_run *run) {

@@ -90,4 +90,10 @@ typedef struct sph_run_report {
 /* NULL before sph_run_close. */
 const sph_run_report *sph_run_report_of(const sph_run *run);
 
+/* An output folder made when missing (parents too) and tried by writing a
+ * file in it; SPH_ERR_ARG naming it otherwise. */
+sph_status sph_run_output_dir(const char *dir, sph_error *err);
+/* mkdir -p: 0, or -1 with errno */
+int sph_mkdir_p(const char *path);
+
 #endif

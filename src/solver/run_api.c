@@ -118,7 +118,7 @@ sph_status sph_run_energy(sph_run *run, double *kinetic, double *strain,
   return SPH_OK;
 }
 
-static int mkdir_p(const char *path) {
+int sph_mkdir_p(const char *path) {
   char buf[1024];
   snprintf(buf, sizeof buf, "%s", path);
   for (char *p = buf + 1; *p; ++p)
@@ -133,7 +133,7 @@ static int mkdir_p(const char *path) {
 
 sph_status sph_run_output_dir(const char *dir, sph_error *err) {
   struct stat st;
-  if (mkdir_p(dir) != 0 || stat(dir, &st) != 0)
+  if (sph_mkdir_p(dir) != 0 || stat(dir, &st) != 0)
     return sph_error_set(err, SPH_ERR_ARG,
                          "cannot create the output folder %s: %s", dir,
                          strerror(errno));

@@ -168,3 +168,14 @@ def test_request_stop(scenes):
         t = run.time
         assert run.advance() == "stopped" and run.time == t
     assert run.summary.state == "stopped"
+
+
+def test_request_stop_named_in_summary(scenes, tmp_path):
+    # a stop asked from Python is no signal: summary.json says "request"
+    out = tmp_path / "stopped"
+    with column(scenes, out=out) as run:
+        run.request_stop()
+        assert run.advance() == "stopped"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped_by"] == "request"
+    assert summary["completed"] is False
