@@ -403,9 +403,7 @@ static double box_corner(const sph_domain_plane *p, const double *lo,
                          const double *hi, int k, double X[3]) {
   for (int c = 0; c < 3; ++c)
     X[c] = k >> c & 1 ? hi[c] : lo[c];
-  return p->axis >= 0
-             ? X[p->axis] - p->at
-             : X[0] * p->n[0] + X[1] * p->n[1] + X[2] * p->n[2] - p->at;
+  return sph_plane_distance(p, X);
 }
 
 /* reflection of the box lo, hi (bounding the reflected corners) */
@@ -415,12 +413,11 @@ static void reflect_box(const sph_domain_plane *p, const double *lo,
   for (int c = 0; c < 3; ++c)
     olo[c] = INFINITY, ohi[c] = -INFINITY;
   for (int k = 0; k < 8; ++k) {
-    double X[3], dist = box_corner(p, lo, hi, k, X);
+    double X[3], dist = box_corner(p, lo, hi, k, X), y[3];
+    sph_plane_reflect(p, X, dist, y);
     for (int c = 0; c < 3; ++c) {
-      double y = p->axis >= 0 ? (c == p->axis ? 2.0 * p->at - X[c] : X[c])
-                              : X[c] - 2.0 * dist * p->n[c];
-      olo[c] = fmin(olo[c], y);
-      ohi[c] = fmax(ohi[c], y);
+      olo[c] = fmin(olo[c], y[c]);
+      ohi[c] = fmax(ohi[c], y[c]);
     }
   }
 }

@@ -33,7 +33,7 @@
 
 /* F^c of the real particles (eq. 37-39) */
 static void bond_defgrad_owned(tl_bond *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
@@ -50,11 +50,11 @@ static void bond_defgrad_owned(tl_bond *m, long n) {
 /* the same mirrored onto the images (over MPI ranks those of ghosts from
  * the ghosts' F^c) */
 static sph_status bond_defgrad(tl_bond *m, long n, sph_error *err) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   bond_defgrad_owned(m, n);
-  SPH_TRY(tl_image_sources(m->sim, ref, m->Fc, 9, err));
+  SPH_TRY(sph_mirror_sources(m->sim, ref, m->Fc, 9, err));
   if (ref->n_ext > ref->n)
-    tl_mirror_refresh(ref, m->x, m->p, m->Fc, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->Fc, NULL, NULL);
   return SPH_OK;
 }
 
@@ -63,15 +63,15 @@ static sph_status bond_defgrad(tl_bond *m, long n, sph_error *err) {
  * their owners) */
 static sph_status deformation_and_stress(tl_bond *m, const double **Fs,
                                          sph_error *err) {
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   sph_domain *d = m->sim->domain;
   long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
   SPH_TRY(sph_domain_exchange(d, m->x, 3, err));
   SPH_TRY(sph_domain_exchange(d, m->p, 3, err));
   if (!m->bond) /* the images' stress is at their F */
-    SPH_TRY(tl_image_sources(m->sim, ref, m->F, 9, err));
+    SPH_TRY(sph_mirror_sources(m->sim, ref, m->F, 9, err));
   if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
   *Fs = m->F;
   if (m->bond) {
     SPH_TRY(bond_defgrad(m, n, err));
@@ -94,7 +94,7 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
                               sph_error *err) {
   tl_bond *m = ctx;
   sph_sim *sim = m->sim;
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   long n = (long)ref->n;
   double t0 = sph_wtime();
@@ -122,12 +122,12 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
       m->dx[3 * a + c] = va[c];
     }
   }
-  return tl_rates_terms(sim, ref, m->dp, m->timer_force, t0, t, err);
+  return sph_step_rates_terms(sim, ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status tl_bond_constrain(void *ctx, double t, sph_error *err) {
   tl_bond *m = ctx;
-  return tl_constrain_terms(m->sim, &m->ref, t, err);
+  return sph_step_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 /* ---- ops
@@ -137,16 +137,16 @@ static sph_status tl_bond_constrain(void *ctx, double t, sph_error *err) {
  * eq. 32 from the smallest principal stretches of F (or c_p^Lin) */
 static double tl_bond_stable_dt(sph_sim *sim) {
   tl_bond *m = sim->method_data;
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
   /* over MPI ranks the pairs read the ghosts' x and stretches, the images
    * of ghosts the ghosts' x and F */
   if (sph_domain_exchange(sim->domain, m->x, 3, NULL) != SPH_OK ||
-      (m->pair_speed && tl_image_sources(sim, ref, m->F, 9, NULL) != SPH_OK))
+      (m->pair_speed && sph_mirror_sources(sim, ref, m->F, 9, NULL) != SPH_OK))
     return NAN;
   if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
   double lam_min = 1.0;
   if (m->pair_speed) {
     lam_min = INFINITY;
@@ -183,34 +183,34 @@ static double tl_bond_stable_dt(sph_sim *sim) {
 
 static sph_status tl_bond_step(sph_sim *sim, double dt, sph_error *err) {
   tl_bond *m = sim->method_data;
-  return tl_rk_step(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
-                    dt, err);
+  return sph_step_rk(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
+                     dt, err);
 }
 
 static sph_status tl_bond_derive(sph_sim *sim, sph_error *err) {
   tl_bond *m = sim->method_data;
   const double *Fs;
   SPH_TRY(deformation_and_stress(m, &Fs, err));
-  tl_derive(sim, &m->ref, NULL, NULL, Fs);
-  return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
+  sph_ref_derive(sim, &m->ref, NULL, NULL, Fs);
+  return sph_step_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
 
 /* strain energy at the F the stress is evaluated at */
 static void tl_bond_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_bond *m = sim->method_data;
-  tl_reference r = m->ref;
+  sph_ref r = m->ref;
   if (m->bond) {
     bond_defgrad_owned(m, (long)r.n);
     r.F = m->Fc;
   }
-  tl_energy(sim, &r, NULL, NULL, kinetic, strain);
+  sph_ref_energy(sim, &r, NULL, NULL, kinetic, strain);
 }
 
 static void tl_bond_destroy(sph_sim *sim) {
   tl_bond *m = sim->method_data;
   if (!m)
     return;
-  tl_reference_destroy(&m->ref);
+  sph_ref_destroy(&m->ref);
   double *arrays[] = {m->v,       m->gv, m->fa, m->fb,  m->q,  m->lap,
                       m->lap_sym, m->Mc, m->Fc, m->lam, m->x0, m->p0,
                       m->F0,      m->dx, m->dp, m->dF};
@@ -232,11 +232,12 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
  * configuration */
 static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
                                int symmetric, int need_lap, sph_error *err) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   size_t ne = ref->n_ext, count = nl->count;
   /* over MPI ranks the ghosts' rows are not whole: their slots toward this
-   * rank's particles come from their owners' coefficients (tl_ghost_slots) */
+   * rank's particles come from their owners' coefficients (sph_ref_ghost_slots)
+   */
   sph_cloud cloud = {.n = ref->n_img,
                      .partial = ref->partial,
                      .dim = sim->scene->dimension,
@@ -253,14 +254,15 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
       (st = alloc_zero(&w, count, err)) != SPH_OK ||
       (st = alloc_zero(&wself, ne, err)) != SPH_OK ||
       (need_lap && (st = alloc_zero(&lap, count, err)) != SPH_OK) ||
-      (st = tl_reference_reverse_slots(ref, &rev, err)) != SPH_OK ||
+      (st = sph_ref_reverse_slots(ref, &rev, err)) != SPH_OK ||
       (st = sph_correction_gradient(&cloud, kind, g, NULL, NULL, err)) !=
           SPH_OK ||
       (st = sph_correction_kernel(&cloud, first_order ? 1 : 0, w, wself,
                                   err)) != SPH_OK ||
       (need_lap &&
        (st = sph_correction_laplacian(&cloud, lap, err)) != SPH_OK) ||
-      (st = tl_ghost_slots(sim, ref, &cloud, kind, rev, g, lap, err)) != SPH_OK)
+      (st = sph_ref_ghost_slots(sim, ref, &cloud, kind, rev, g, lap, err)) !=
+          SPH_OK)
     goto done;
   for (size_t a = 0; a < cloud.n; ++a) {
     double *M = m->Mc + 9 * a;
@@ -353,7 +355,7 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           err, SPH_ERR_RANGE, "JST coefficients must be >= 0");
 
   /* reference configuration with images across symmetry planes, state */
-  SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
+  SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
   size_t ne = m->ref.n_ext, count = m->ref.nl->count;
   m->x = m->ref.x;
   m->p = m->ref.p;
@@ -402,13 +404,13 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .cp_now = m->pair_speed ? &m->cp_now : NULL};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
-  return tl_essential_bc_attach(sim, &m->ref, tl_bond_constrain, m, err);
+  SPH_TRY(sph_step_external_terms(sim, &m->ref, err));
+  return sph_step_essential_bc(sim, &m->ref, tl_bond_constrain, m, err);
 }
 
 static int tl_bond_state(sph_sim *sim, sph_state_array *out) {
   tl_bond *m = sim->method_data;
-  return tl_state_xpF(&m->ref, out);
+  return sph_step_state_xpF(&m->ref, out);
 }
 
 const sph_method_ops tl_bond_method_ops = {
@@ -419,7 +421,7 @@ const sph_method_ops tl_bond_method_ops = {
                  "37-39",
     .conserves_angular_momentum = 0,
     .distributed = 1,
-    .fields = TL_OUTPUT_FIELDS,
+    .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = tl_bond_setup,
     .stable_dt = tl_bond_stable_dt,
     .step = tl_bond_step,

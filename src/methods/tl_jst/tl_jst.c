@@ -14,8 +14,8 @@
 
 #include "core/corrections.h"
 #include "core/tensor.h"
+#include "methods/common/pair_iact.h"
 #include "methods/registry_impl.h"
-#include "methods/tl_iact.h"
 #include "methods/tl_jst/tl_jst_iact.h"
 #include "methods/tl_jst/tl_jst_impl.h"
 #include "terms/terms_impl.h"
@@ -38,9 +38,9 @@ static inline void strain_measures(const tl_jst *m, const double *F,
 /* mirror images take their sources' state */
 static void refresh_images(tl_jst *m) {
   if (m->ref.n_ext > m->ref.n)
-    tl_mirror_refresh(&m->ref, m->x, m->p, m->F,
-                      m->fields == TL_JST_PFHJ ? m->H : NULL,
-                      m->fields == TL_JST_PF ? NULL : m->J);
+    sph_mirror_state(&m->ref, m->x, m->p, m->F,
+                     m->fields == TL_JST_PFHJ ? m->H : NULL,
+                     m->fields == TL_JST_PF ? NULL : m->J);
 }
 
 /* P, and Q = P L for the conservative force, of every point; the
@@ -57,7 +57,7 @@ static void compute_stress(tl_jst *m, long n, int store_P) {
     if (store_P)
       memcpy(m->P + 9 * a, P, sizeof P);
     if (conservative)
-      tl_force_matrix_of(&m->ref, (size_t)a, P);
+      sph_ref_force_matrix_of(&m->ref, (size_t)a, P);
   }
 }
 
@@ -69,7 +69,7 @@ static void compute_stress(tl_jst *m, long n, int store_P) {
 static inline void particle_rates(tl_jst *m, size_t a, double G[9],
                                   const double dp[3]) {
   double inv_rho0 = 1.0 / m->ref.rho0[a];
-  tl_iact_gradient_correct(G, m->ref.L + 9 * a);
+  ref_iact_gradient_correct(G, m->ref.L + 9 * a);
   for (int k = 0; k < 9; ++k)
     G[k] *= inv_rho0;
   memcpy(m->dF + 9 * a, G, 9 * sizeof *G);
@@ -89,12 +89,12 @@ static inline void particle_rates(tl_jst *m, size_t a, double G[9],
 /* particle a's share of sweep_conservative; with `lap`, also L[p] */
 static inline __attribute__((always_inline)) void
 conservative_particle(tl_jst *m, size_t a, const double *lap) {
-  const tl_reference *ref = &m->ref;
-  tl_sums s;
-  tl_pair_sums(ref, a, m->p, 1, lap, &s);
+  const sph_ref *ref = &m->ref;
+  ref_sums s;
+  sph_ref_pair_sums(ref, a, m->p, 1, lap, &s);
   double G[9], f[3], self[3];
-  tl_sums_store(&s, G, f);
-  tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
+  ref_sums_store(&s, G, f);
+  ref_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
   for (int c = 0; c < 3; ++c)
     f[c] += self[c];
   particle_rates(m, a, G, f);
@@ -122,7 +122,7 @@ static void sweep_conservative(tl_jst *m, long n) {
 /* the symmetric force of seed 003 eq. 11 with the corrected gradient, or
  * (eq. 30) with the uncorrected one */
 static void sweep_symmetric(tl_jst *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   int corrected = m->force == TL_JST_SYMMETRIC;
 #pragma omp parallel for schedule(static)
@@ -132,8 +132,8 @@ static void sweep_symmetric(tl_jst *m, long n) {
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
       double r[3], g[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      ref_iact_pair_vector(ref->X, (size_t)a, b, r);
+      ref_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
       for (int c = 0; c < 3; ++c)
         r[c] *= ref->w[k];
       if (corrected)
@@ -149,7 +149,7 @@ static void sweep_symmetric(tl_jst *m, long n) {
 
 /* the kernel-gradient force of seed 000 eq. 31 */
 static void sweep_eq31(tl_jst *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   const double *V = ref->V;
 #pragma omp parallel for schedule(static)
@@ -159,8 +159,8 @@ static void sweep_eq31(tl_jst *m, long n) {
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
       double r[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      ref_iact_pair_vector(ref->X, (size_t)a, b, r);
+      ref_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
       tl_jst_iact_force_kernel(T, V[b], m->P + 9 * b, m->fgrad + 3 * m->rev[k]);
     }
     /* the b = a term of eq. 31 */
@@ -179,11 +179,11 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   /* over MPI ranks the sweep reads the ghosts' p and Q (or P), which their
    * owners compute; images of ghosts mirror the ghosts' p, F, H and J */
   SPH_TRY(sph_domain_exchange(sim->domain, m->p, 3, err));
-  SPH_TRY(tl_image_sources(sim, &m->ref, m->F, 9, err));
+  SPH_TRY(sph_mirror_sources(sim, &m->ref, m->F, 9, err));
   if (m->fields == TL_JST_PFHJ)
-    SPH_TRY(tl_image_sources(sim, &m->ref, m->H, 9, err));
+    SPH_TRY(sph_mirror_sources(sim, &m->ref, m->H, 9, err));
   if (m->fields != TL_JST_PF)
-    SPH_TRY(tl_image_sources(sim, &m->ref, m->J, 1, err));
+    SPH_TRY(sph_mirror_sources(sim, &m->ref, m->J, 1, err));
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_img, 0);
   if (m->force == TL_JST_CONSERVATIVE)
@@ -231,35 +231,35 @@ static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
 
 static double tl_jst_stable_dt(sph_sim *sim) {
   tl_jst *m = sim->method_data;
-  return tl_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
+  return sph_ref_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
 }
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
-  return tl_rk_step(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
-                    dt, err);
+  return sph_step_rk(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
+                     dt, err);
 }
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   tl_jst *m = sim->method_data;
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_img, 1);
-  tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
-            m->fields == TL_JST_PF ? NULL : m->J, NULL);
-  return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
+  sph_ref_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
+                 m->fields == TL_JST_PF ? NULL : m->J, NULL);
+  return sph_step_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
 
 static void tl_jst_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_jst *m = sim->method_data;
-  tl_energy(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
-            m->fields == TL_JST_PF ? NULL : m->J, kinetic, strain);
+  sph_ref_energy(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
+                 m->fields == TL_JST_PF ? NULL : m->J, kinetic, strain);
 }
 
 static void tl_jst_destroy(sph_sim *sim) {
   tl_jst *m = sim->method_data;
   if (!m)
     return;
-  tl_reference_destroy(&m->ref);
+  sph_ref_destroy(&m->ref);
   free(m->H);
   free(m->lap);
   free(m->lu_p);
@@ -371,7 +371,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
       return sph_node_error(jst, err, SPH_ERR_RANGE,
                             "JST coefficients must be >= 0");
   /* reference configuration (with mirror images) and the state */
-  SPH_TRY(tl_reference_create(&m->ref, sim, bc == 0, err));
+  SPH_TRY(sph_ref_create(&m->ref, sim, bc == 0, err));
   size_t ne = m->ref.n_ext;
   /* symmetry planes exert forces: the totals the projections zero are not
    * zero there */
@@ -388,7 +388,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->J = m->ref.J;
   m->P = m->ref.P;
   if (m->fields == TL_JST_PFHJ) {
-    SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->H, err));
+    SPH_TRY(sph_ref_alloc(&m->ref, 9, &m->H, err));
     for (size_t a = 0; a < ne; ++a)
       sph_mat3_cofactor(m->F + 9 * a, m->H + 9 * a);
   }
@@ -408,9 +408,9 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
     SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
                                     m->fgrad_self, NULL, err));
-    SPH_TRY(tl_reference_reverse_slots(&m->ref, &m->rev, err));
-    SPH_TRY(tl_ghost_slots(sim, &m->ref, &cloud, SPH_GRAD_W1, m->rev, m->fgrad,
-                           NULL, err));
+    SPH_TRY(sph_ref_reverse_slots(&m->ref, &m->rev, err));
+    SPH_TRY(sph_ref_ghost_slots(sim, &m->ref, &cloud, SPH_GRAD_W1, m->rev,
+                                m->fgrad, NULL, err));
   }
   int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
   if (need_p || need_j) {
@@ -425,8 +425,8 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
              ++k) {
           size_t b = (size_t)m->ref.nl->index[k];
           double r[3], g[3];
-          tl_iact_pair_vector(X, a, b, r);
-          tl_reference_gradient(&m->ref, a, k, g);
+          ref_iact_pair_vector(X, a, b, r);
+          sph_ref_gradient(&m->ref, a, k, g);
           m->lap[k] = -2.0 * sph_vec3_dot(r, g) / sph_vec3_dot(r, r);
         }
     }
@@ -484,7 +484,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .exchange_u = !m->ref.sync_images};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
+  SPH_TRY(sph_step_external_terms(sim, &m->ref, err));
   int planes = 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
@@ -495,7 +495,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                                        lagrange_momentum, err));
     return tl_jst_constrain(m, 0.0, err);
   }
-  return tl_essential_bc_attach(sim, &m->ref, tl_jst_constrain, m, err);
+  return sph_step_essential_bc(sim, &m->ref, tl_jst_constrain, m, err);
 }
 
 static int tl_jst_state(sph_sim *sim, sph_state_array *out) {
@@ -517,7 +517,7 @@ const sph_method_ops tl_jst_method_ops = {
                  "eq. 11",
     .conserves_angular_momentum = 1,
     .distributed = 1,
-    .fields = TL_OUTPUT_FIELDS,
+    .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = tl_jst_setup,
     .stable_dt = tl_jst_stable_dt,
     .step = tl_jst_step,
