@@ -67,6 +67,12 @@ size_t sph_domain_mirror_boxes(const sph_domain_plane *planes, int np,
                                double near, double tol, int passes, double *box,
                                size_t max);
 
+/* domain_fixed.c: a halo larger than the domain (ng_support ghosts within
+ * one support of N particles): more ranks than useful; then the exchange's
+ * plan from the ghosts' owners gowner (collective, agreed; MPI only). */
+sph_status sph_domain_halo_plan(sph_domain *d, sph_status st, size_t ng_support,
+                                size_t N, const int *gowner, sph_error *err);
+
 /* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
  * over R ranks; the dynamic state from the first partition (the particle
  * count and the cut tree, axis and cut R + 1 each: nothing N-sized is
