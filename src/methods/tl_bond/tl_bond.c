@@ -303,19 +303,23 @@ done:
   return st;
 }
 
-static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct tl_bond_options {
+  int bond;        /* deformation_gradient: bond (else average) */
+  int first_order; /* correction: first_order (else zeroth_order) */
+  int symmetric;   /* force: symmetric (else conservative) */
+  int pair_speed;  /* wave_speed: pair (else linear) */
+  sph_rk_step integrate;
+  double cfl;
+  double e2p, e4p; /* JST on p */
+} tl_bond_options;
+
+static sph_status tl_bond_options_parse(sph_node *opt, tl_bond_options *o,
+                                        sph_error *err) {
   static const char *const keys[] = {
       "name", "deformation_gradient", "correction", "force", "integrator",
       "cfl",  "wave_speed",           "jst",        NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  tl_bond *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "tl-bond");
-  sim->method_data = m;
-  m->sim = sim;
-  size_t n = sim->ps->n;
-
-  /* options */
   static const char *const defgrads[] = {"bond", "average", NULL};
   static const char *const corrections[] = {"first_order", "zeroth_order",
                                             NULL};
@@ -331,28 +335,47 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_node_get_choice(opt, "integrator", integrators, "ssp-rk3", &integ,
                               err));
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "pair", &ws, err));
-  m->bond = dg == 0;
-  m->pair_speed = ws == 0;
-  m->integrate = integ == 0 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.9, &m->cfl, err));
+  o->bond = dg == 0;
+  o->first_order = corr == 0;
+  o->symmetric = fo == 0;
+  o->pair_speed = ws == 0;
+  o->integrate = integ == 0 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.9, &o->cfl, err));
   /* both integrators are SSP with coefficient 1: stable up to the forward
    * Euler limit, CFL 1 (seed 004 runs up to 0.9) */
-  if (!(m->cfl > 0.0 && m->cfl <= 1.0))
+  if (!(o->cfl > 0.0 && o->cfl <= 1.0))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
                           "cfl must be in (0, 1] (the SSP limit of %s), got %g",
-                          integrators[integ], m->cfl);
+                          integrators[integ], o->cfl);
   sph_node *jst;
   SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
   if (jst->kind != SPH_NODE_MAP)
     return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
   static const char *const jkeys[] = {"eps2_p", "eps4_p", NULL};
   SPH_TRY(sph_node_check_keys(jst, jkeys, err));
-  double e2p, e4p;
-  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
-  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
-  if (e2p < 0.0 || e4p < 0.0)
-    return sph_node_error(sph_node_child(jst, e2p < 0.0 ? "eps2_p" : "eps4_p"),
-                          err, SPH_ERR_RANGE, "JST coefficients must be >= 0");
+  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &o->e2p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &o->e4p, err));
+  if (o->e2p < 0.0 || o->e4p < 0.0)
+    return sph_node_error(
+        sph_node_child(jst, o->e2p < 0.0 ? "eps2_p" : "eps4_p"), err,
+        SPH_ERR_RANGE, "JST coefficients must be >= 0");
+  return SPH_OK;
+}
+
+static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  tl_bond_options o = {0};
+  SPH_TRY(tl_bond_options_parse(opt, &o, err));
+  tl_bond *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-bond");
+  sim->method_data = m;
+  m->sim = sim;
+  size_t n = sim->ps->n;
+  m->bond = o.bond;
+  m->pair_speed = o.pair_speed;
+  m->integrate = o.integrate;
+  m->cfl = o.cfl;
+  double e2p = o.e2p, e4p = o.e4p;
 
   /* reference configuration with images across symmetry planes, state */
   SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
@@ -376,7 +399,7 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     SPH_TRY(alloc_zero(&m->Fc, 9 * ne, err));
   if (m->pair_speed)
     SPH_TRY(alloc_zero(&m->lam, ne, err));
-  SPH_TRY(pair_weights(m, sim, corr == 0, fo == 0, need_lap, err));
+  SPH_TRY(pair_weights(m, sim, o.first_order, o.symmetric, need_lap, err));
   m->cp_now = m->ref.cp;
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");

@@ -93,22 +93,37 @@ static void tl_csph_destroy(sph_sim *sim) {
   sim->method_data = NULL;
 }
 
-static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct tl_csph_options {
+  double cfl;
+  int current_wave_speed; /* dt from the current state's c_p */
+} tl_csph_options;
+
+static sph_status tl_csph_options_parse(sph_node *opt, tl_csph_options *o,
+                                        sph_error *err) {
   static const char *const keys[] = {"name", "cfl", "integrator", "wave_speed",
                                      NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  tl_csph *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph");
-  sim->method_data = m;
-  m->sim = sim;
-  SPH_TRY(sph_step_leapfrog_options(opt, &m->cfl, err));
+  SPH_TRY(sph_step_leapfrog_options(opt, &o->cfl, err));
   const char *ws;
   SPH_TRY(sph_node_get_string(opt, "wave_speed", 0, "current", &ws, err));
   if (strcmp(ws, "current") && strcmp(ws, "reference"))
     return sph_node_error(sph_node_child(opt, "wave_speed"), err, SPH_ERR_RANGE,
                           "'%s' is not one of: current, reference", ws);
-  m->current_wave_speed = !strcmp(ws, "current");
+  o->current_wave_speed = !strcmp(ws, "current");
+  return SPH_OK;
+}
+
+static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  tl_csph_options o = {0};
+  SPH_TRY(tl_csph_options_parse(opt, &o, err));
+  tl_csph *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph");
+  sim->method_data = m;
+  m->sim = sim;
+  m->cfl = o.cfl;
+  m->current_wave_speed = o.current_wave_speed;
   SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
   sph_particles *ps = sim->ps;
   m->x = m->ref.x;

@@ -289,7 +289,50 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
   return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "tl-jst arrays");
 }
 
-static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct tl_jst_options {
+  tl_jst_fields fields;
+  tl_jst_force force;
+  int gradient_laplacian; /* laplacian: gradient (else corrected) */
+  sph_rk_step integrate;
+  int lagrange;          /* essential_bc: lagrange (else direct) */
+  int lagrange_momentum; /* the total momentum rows of the projection */
+  int current_wave_speed;
+  double cfl;
+  int amp, jproj; /* angular momentum and JST projections */
+  double e2p, e4p, e2j, e4j;
+} tl_jst_options;
+
+/* The `jst` block's coefficients into o (fields already parsed). */
+static sph_status jst_options_parse(sph_node *opt, tl_jst_options *o,
+                                    sph_error *err) {
+  sph_node *jst;
+  SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
+  if (jst->kind != SPH_NODE_MAP)
+    return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
+  static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
+                                      NULL};
+  SPH_TRY(sph_node_check_keys(jst, jkeys, err));
+  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &o->e2p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &o->e4p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &o->e2j, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &o->e4j, err));
+  if (o->fields == TL_JST_PF && (o->e2j != 0.0 || o->e4j != 0.0))
+    return sph_node_error(
+        sph_node_child(jst, o->e2j != 0.0 ? "eps2_J" : "eps4_J"), err,
+        SPH_ERR_ARG,
+        "fields pF has no J equation; use fields pFJ or "
+        "pFHJ for JST on J, or set it to 0");
+  double eps[4] = {o->e2p, o->e4p, o->e2j, o->e4j};
+  for (int i = 0; i < 4; ++i)
+    if (eps[i] < 0.0)
+      return sph_node_error(jst, err, SPH_ERR_RANGE,
+                            "JST coefficients must be >= 0");
+  return SPH_OK;
+}
+
+static sph_status tl_jst_options_parse(sph_node *opt, tl_jst_options *o,
+                                       sph_error *err) {
   static const char *const keys[] = {"name",
                                      "fields",
                                      "force",
@@ -304,81 +347,175 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                                      "lagrange_momentum",
                                      NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  tl_jst *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "tl-jst");
-  sim->method_data = m;
-  m->sim = sim;
-  const sph_scene *s = sim->scene;
-  sph_particles *ps = sim->ps;
-  size_t n = ps->n;
-
-  /* options */
   static const char *const fields[] = {"pF", "pFJ", "pFHJ", NULL};
   static const char *const forces[] = {"conservative", "symmetric", "eq30",
                                        "eq31", NULL};
   static const char *const laps[] = {"corrected", "gradient", NULL};
   static const char *const integrators[] = {"tvd-rk2", "ssp-rk3", NULL};
   static const char *const bcs[] = {"direct", "lagrange", NULL};
-  int f, fo, lp, integ, bc, amp, jproj;
+  int f, fo, lp, integ, bc;
   SPH_TRY(sph_node_get_choice(opt, "fields", fields, "pF", &f, err));
   SPH_TRY(sph_node_get_choice(opt, "force", forces, "conservative", &fo, err));
   SPH_TRY(sph_node_get_choice(opt, "laplacian", laps, "corrected", &lp, err));
   SPH_TRY(sph_node_get_choice(opt, "integrator", integrators, "tvd-rk2", &integ,
                               err));
   SPH_TRY(sph_node_get_choice(opt, "essential_bc", bcs, "direct", &bc, err));
-  int lagrange_momentum;
-  SPH_TRY(sph_node_get_bool(opt, "lagrange_momentum", 0, 0, &lagrange_momentum,
-                            err));
-  if (lagrange_momentum && bc != 1)
+  SPH_TRY(sph_node_get_bool(opt, "lagrange_momentum", 0, 0,
+                            &o->lagrange_momentum, err));
+  if (o->lagrange_momentum && bc != 1)
     return sph_node_error(sph_node_child(opt, "lagrange_momentum"), err,
                           SPH_ERR_ARG,
                           "lagrange_momentum needs essential_bc: lagrange");
   static const char *const speeds[] = {"current", "reference", NULL};
   int ws;
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "current", &ws, err));
-  m->current_wave_speed = ws == 0;
-  m->integrate = integ == 1 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
-  m->fields = (tl_jst_fields)f;
-  m->force = (tl_jst_force)fo;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
-  if (!(m->cfl > 0.0 && m->cfl <= 1.5))
+  o->current_wave_speed = ws == 0;
+  o->integrate = integ == 1 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
+  o->fields = (tl_jst_fields)f;
+  o->force = (tl_jst_force)fo;
+  o->gradient_laplacian = lp == 1;
+  o->lagrange = bc == 1;
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &o->cfl, err));
+  if (!(o->cfl > 0.0 && o->cfl <= 1.5))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
-                          "cfl must be in (0, 1.5], got %g", m->cfl);
-  SPH_TRY(
-      sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &amp, err));
-  SPH_TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &jproj, err));
-  sph_node *jst;
-  SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
-  if (jst->kind != SPH_NODE_MAP)
-    return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
-  static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
-                                      NULL};
-  SPH_TRY(sph_node_check_keys(jst, jkeys, err));
-  double e2p, e4p, e2j, e4j;
-  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
-  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
-  SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
-  SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
-  if (m->fields == TL_JST_PF && (e2j != 0.0 || e4j != 0.0))
-    return sph_node_error(sph_node_child(jst, e2j != 0.0 ? "eps2_J" : "eps4_J"),
-                          err, SPH_ERR_ARG,
-                          "fields pF has no J equation; use fields pFJ or "
-                          "pFHJ for JST on J, or set it to 0");
-  double eps[4] = {e2p, e4p, e2j, e4j};
-  for (int i = 0; i < 4; ++i)
-    if (eps[i] < 0.0)
-      return sph_node_error(jst, err, SPH_ERR_RANGE,
-                            "JST coefficients must be >= 0");
+                          "cfl must be in (0, 1.5], got %g", o->cfl);
+  SPH_TRY(sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &o->amp,
+                            err));
+  SPH_TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &o->jproj, err));
+  return jst_options_parse(opt, o, err);
+}
+
+/* The per-slot arrays of the chosen force and dissipation: eq. 31's
+ * gradients of W~1 and reverse slots, the Laplacian weights
+ * V_b Lap W~_b(X_a) of the JST term (corrected, or the Brookshaw form with
+ * the corrected gradient of BENCHMARKS D.4). */
+static sph_status setup_slots(tl_jst *m, sph_sim *sim, const sph_cloud *cloud,
+                              int gradient_laplacian, int need_lap,
+                              sph_error *err) {
+  size_t ne = m->ref.n_ext;
+  if (m->force == TL_JST_EQ31) {
+    SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
+    SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
+    SPH_TRY(sph_correction_gradient(cloud, SPH_GRAD_W1, m->fgrad, m->fgrad_self,
+                                    NULL, err));
+    SPH_TRY(sph_ref_reverse_slots(&m->ref, &m->rev, err));
+    SPH_TRY(sph_ref_ghost_slots(sim, &m->ref, cloud, SPH_GRAD_W1, m->rev,
+                                m->fgrad, NULL, err));
+  }
+  if (!need_lap)
+    return SPH_OK;
+  SPH_TRY(alloc_zero(&m->lap, m->ref.nl->count, err));
+  if (!gradient_laplacian) {
+    SPH_TRY(sph_correction_laplacian(cloud, m->lap, err));
+  } else {
+    const double *X = m->ref.X;
+    for (size_t a = 0; a < cloud->n; ++a)
+      for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k) {
+        size_t b = (size_t)m->ref.nl->index[k];
+        double r[3], g[3];
+        ref_iact_pair_vector(X, a, b, r);
+        sph_ref_gradient(&m->ref, a, k, g);
+        m->lap[k] = -2.0 * sph_vec3_dot(r, g) / sph_vec3_dot(r, r);
+      }
+  }
+  /* the JST term takes V_b Lap W~_b(X_a) */
+  for (size_t a = 0; a < cloud->n; ++a)
+    for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k)
+      m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
+  return SPH_OK;
+}
+
+/* The integrator's copies and rates of the variables of the chosen
+ * fields. */
+static sph_status setup_ode(tl_jst *m, size_t n, sph_error *err) {
+  size_t len[5] = {3 * n, 3 * n, 9 * n, 9 * n, n};
+  double **y[5] = {&m->x, &m->p, &m->F, &m->H, &m->J};
+  double **y0[5] = {&m->x0, &m->p0, &m->F0, &m->H0, &m->J0};
+  double **r[5] = {&m->dx, &m->dp, &m->dF, &m->dH, &m->dJ};
+  int use[5] = {1, 1, 1, m->fields == TL_JST_PFHJ, m->fields != TL_JST_PF};
+  sph_ode *ode = &m->ode;
+  for (int i = 0; i < 5; ++i)
+    if (use[i])
+      SPH_TRY(sph_ode_add(ode, *y[i], len[i], y0[i], r[i], err));
+  SPH_TRY(alloc_zero(&m->xmoment, 3 * n, err));
+  ode->rhs = tl_jst_rhs;
+  ode->constrain = tl_jst_constrain;
+  ode->ctx = m;
+  return SPH_OK;
+}
+
+/* The terms, only those asked for, in the order of Algorithm 1; the
+ * essential boundary conditions imposed on the initial state. */
+static sph_status setup_terms(tl_jst *m, sph_sim *sim, const sph_cloud *cloud,
+                              const tl_jst_options *o, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  if (o->amp)
+    SPH_TRY(angular_momentum_projection_create(sim, err));
+  if (o->e2p != 0.0 || o->e4p != 0.0) {
+    if (m->force == TL_JST_CONSERVATIVE)
+      SPH_TRY(alloc_zero(&m->lu_p, 3 * m->ref.n_ext, err));
+    jst_params jp = {.nl = m->ref.nl,
+                     .lap = m->lap,
+                     .lu = m->lu_p,
+                     .V = m->ref.V,
+                     .ncomp = 3,
+                     .eps2 = o->e2p,
+                     .eps4 = o->e4p,
+                     .cp = m->ref.cp,
+                     .h = sim->dp,
+                     .project = o->jproj};
+    SPH_TRY(jst_dissipation_create(sim, &jp, err));
+  }
+  if (o->e2j != 0.0 || o->e4j != 0.0) {
+    jst_params jp = {.nl = m->ref.nl,
+                     .lap = m->lap,
+                     .V = m->ref.V,
+                     .ncomp = 1,
+                     .eps2 = o->e2j,
+                     .eps4 = o->e4j,
+                     .cp = m->ref.cp,
+                     .h = sim->dp,
+                     .project = o->jproj,
+                     .exchange_u = !m->ref.sync_images};
+    SPH_TRY(jst_dissipation_create(sim, &jp, err));
+  }
+  SPH_TRY(sph_step_external_terms(sim, &m->ref, err));
+  int planes = 0;
+  for (size_t k = 0; k < s->nboundaries; ++k)
+    planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
+              s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY;
+  if (o->lagrange && (planes || sph_scene_has_essential_bc(s))) {
+    /* symmetry planes are constraints here, not mirror images */
+    SPH_TRY(lagrange_projection_create(sim, cloud, m->ref.rho0,
+                                       o->lagrange_momentum, err));
+    return tl_jst_constrain(m, 0.0, err);
+  }
+  return sph_step_essential_bc(sim, &m->ref, tl_jst_constrain, m, err);
+}
+
+static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  tl_jst_options o = {0};
+  SPH_TRY(tl_jst_options_parse(opt, &o, err));
+  tl_jst *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-jst");
+  sim->method_data = m;
+  m->sim = sim;
+  size_t n = sim->ps->n;
+  m->current_wave_speed = o.current_wave_speed;
+  m->integrate = o.integrate;
+  m->fields = o.fields;
+  m->force = o.force;
+  m->cfl = o.cfl;
   /* reference configuration (with mirror images) and the state */
-  SPH_TRY(sph_ref_create(&m->ref, sim, bc == 0, err));
+  SPH_TRY(sph_ref_create(&m->ref, sim, !o.lagrange, err));
   size_t ne = m->ref.n_ext;
   /* symmetry planes exert forces: the totals the projections zero are not
    * zero there */
-  if (m->ref.n_img > n && (amp || jproj))
+  if (m->ref.n_img > n && (o.amp || o.jproj))
     return sph_node_error(
-        sph_node_child(opt,
-                       amp ? "angular_momentum_projection" : "jst_projection"),
+        sph_node_child(opt, o.amp ? "angular_momentum_projection"
+                                  : "jst_projection"),
         err, SPH_ERR_ARG,
         "the momentum projections assume a free body; with symmetry planes "
         "set angular_momentum_projection and jst_projection to false");
@@ -395,7 +532,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   /* over MPI ranks the ghosts' rows are not used (nor complete) */
   sph_cloud cloud = {.n = m->ref.n_img,
                      .partial = m->ref.partial,
-                     .dim = s->dimension,
+                     .dim = sim->scene->dimension,
                      .x = m->ref.X,
                      .volume = m->ref.V,
                      .nl = m->ref.nl,
@@ -403,99 +540,12 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
              : m->force == TL_JST_EQ31       ? sweep_eq31
                                              : sweep_symmetric;
-  if (m->force == TL_JST_EQ31) {
-    SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
-    SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
-    SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
-                                    m->fgrad_self, NULL, err));
-    SPH_TRY(sph_ref_reverse_slots(&m->ref, &m->rev, err));
-    SPH_TRY(sph_ref_ghost_slots(sim, &m->ref, &cloud, SPH_GRAD_W1, m->rev,
-                                m->fgrad, NULL, err));
-  }
-  int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
-  if (need_p || need_j) {
-    SPH_TRY(alloc_zero(&m->lap, m->ref.nl->count, err));
-    if (lp == 0) {
-      SPH_TRY(sph_correction_laplacian(&cloud, m->lap, err));
-    } else {
-      /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
-      const double *X = m->ref.X;
-      for (size_t a = 0; a < cloud.n; ++a)
-        for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1];
-             ++k) {
-          size_t b = (size_t)m->ref.nl->index[k];
-          double r[3], g[3];
-          ref_iact_pair_vector(X, a, b, r);
-          sph_ref_gradient(&m->ref, a, k, g);
-          m->lap[k] = -2.0 * sph_vec3_dot(r, g) / sph_vec3_dot(r, r);
-        }
-    }
-    /* the JST term takes V_b Lap W~_b(X_a) */
-    for (size_t a = 0; a < cloud.n; ++a)
-      for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k)
-        m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
-  }
+  int need_lap = o.e2p != 0.0 || o.e4p != 0.0 || o.e2j != 0.0 || o.e4j != 0.0;
+  SPH_TRY(setup_slots(m, sim, &cloud, o.gradient_laplacian, need_lap, err));
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");
-
-  /* integrator storage */
-  size_t len[5] = {3 * n, 3 * n, 9 * n, 9 * n, n};
-  double **y[5] = {&m->x, &m->p, &m->F, &m->H, &m->J};
-  double **y0[5] = {&m->x0, &m->p0, &m->F0, &m->H0, &m->J0};
-  double **r[5] = {&m->dx, &m->dp, &m->dF, &m->dH, &m->dJ};
-  int use[5] = {1, 1, 1, m->fields == TL_JST_PFHJ, m->fields != TL_JST_PF};
-  sph_ode *ode = &m->ode;
-  for (int i = 0; i < 5; ++i)
-    if (use[i])
-      SPH_TRY(sph_ode_add(ode, *y[i], len[i], y0[i], r[i], err));
-  SPH_TRY(alloc_zero(&m->xmoment, 3 * n, err));
-  ode->rhs = tl_jst_rhs;
-  ode->constrain = tl_jst_constrain;
-  ode->ctx = m;
-
-  /* terms, only those asked for, in the order of Algorithm 1 */
-  if (amp)
-    SPH_TRY(angular_momentum_projection_create(sim, err));
-  if (need_p) {
-    if (m->force == TL_JST_CONSERVATIVE)
-      SPH_TRY(alloc_zero(&m->lu_p, 3 * ne, err));
-    jst_params jp = {.nl = m->ref.nl,
-                     .lap = m->lap,
-                     .lu = m->lu_p,
-                     .V = m->ref.V,
-                     .ncomp = 3,
-                     .eps2 = e2p,
-                     .eps4 = e4p,
-                     .cp = m->ref.cp,
-                     .h = sim->dp,
-                     .project = jproj};
-    SPH_TRY(jst_dissipation_create(sim, &jp, err));
-  }
-  if (need_j) {
-    jst_params jp = {.nl = m->ref.nl,
-                     .lap = m->lap,
-                     .V = m->ref.V,
-                     .ncomp = 1,
-                     .eps2 = e2j,
-                     .eps4 = e4j,
-                     .cp = m->ref.cp,
-                     .h = sim->dp,
-                     .project = jproj,
-                     .exchange_u = !m->ref.sync_images};
-    SPH_TRY(jst_dissipation_create(sim, &jp, err));
-  }
-  SPH_TRY(sph_step_external_terms(sim, &m->ref, err));
-  int planes = 0;
-  for (size_t k = 0; k < s->nboundaries; ++k)
-    planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
-              s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY;
-  if (bc == 1 && (planes || sph_scene_has_essential_bc(s))) {
-    /* symmetry planes are constraints here, not mirror images */
-    SPH_TRY(lagrange_projection_create(sim, &cloud, m->ref.rho0,
-                                       lagrange_momentum, err));
-    return tl_jst_constrain(m, 0.0, err);
-  }
-  return sph_step_essential_bc(sim, &m->ref, tl_jst_constrain, m, err);
+  SPH_TRY(setup_ode(m, n, err));
+  return setup_terms(m, sim, &cloud, &o, err);
 }
 
 static int tl_jst_state(sph_sim *sim, sph_state_array *out) {

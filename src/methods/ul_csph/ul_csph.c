@@ -326,17 +326,21 @@ static void ul_csph_destroy(sph_sim *sim) {
   sim->method_data = NULL;
 }
 
-static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct ul_csph_options {
+  double cfl;
+  int update_every;       /* steps between reference updates */
+  double update_distance; /* or: the largest displacement, in spacings */
+  double eta;             /* Hessian-difference stabilisation (sec. 3.4) */
+} ul_csph_options;
+
+static sph_status ul_csph_options_parse(sph_node *opt, ul_csph_options *o,
+                                        sph_error *err) {
   static const char *const keys[] = {
       "name", "cfl", "integrator", "update_every", "update_distance",
       "eta",  NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  ul_csph *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph");
-  sim->method_data = m;
-  m->sim = sim;
-  SPH_TRY(sph_step_leapfrog_options(opt, &m->cfl, err));
+  SPH_TRY(sph_step_leapfrog_options(opt, &o->cfl, err));
   int by_steps = sph_node_child(opt, "update_every") != NULL;
   long every;
   SPH_TRY(sph_node_get_int(opt, "update_every", 0, 1, &every, err));
@@ -346,21 +350,36 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "update_every must be a number of steps >= 1, got "
                           "%ld",
                           every);
-  m->update_every = (int)every;
+  o->update_every = (int)every;
   SPH_TRY(sph_node_get_double(opt, "update_distance", 0, 0.0,
-                              &m->update_distance, err));
-  if (!(m->update_distance >= 0.0 && m->update_distance <= 1e6))
+                              &o->update_distance, err));
+  if (!(o->update_distance >= 0.0 && o->update_distance <= 1e6))
     return sph_node_error(
         sph_node_child(opt, "update_distance"), err, SPH_ERR_RANGE,
-        "update_distance must be >= 0 spacings, got %g", m->update_distance);
-  if (by_steps && m->update_distance > 0.0)
+        "update_distance must be >= 0 spacings, got %g", o->update_distance);
+  if (by_steps && o->update_distance > 0.0)
     return sph_node_error(sph_node_child(opt, "update_distance"), err,
                           SPH_ERR_RANGE,
                           "give update_every or update_distance, not both");
-  SPH_TRY(sph_node_get_double(opt, "eta", 0, 0.3, &m->eta, err));
-  if (!(m->eta >= 0.0 && m->eta <= 100.0))
+  SPH_TRY(sph_node_get_double(opt, "eta", 0, 0.3, &o->eta, err));
+  if (!(o->eta >= 0.0 && o->eta <= 100.0))
     return sph_node_error(sph_node_child(opt, "eta"), err, SPH_ERR_RANGE,
-                          "eta must be in [0, 100], got %g", m->eta);
+                          "eta must be in [0, 100], got %g", o->eta);
+  return SPH_OK;
+}
+
+static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  ul_csph_options o = {0};
+  SPH_TRY(ul_csph_options_parse(opt, &o, err));
+  ul_csph *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph");
+  sim->method_data = m;
+  m->sim = sim;
+  m->cfl = o.cfl;
+  m->update_every = o.update_every;
+  m->update_distance = o.update_distance;
+  m->eta = o.eta;
   const sph_scene *s = sim->scene;
   SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
   size_t ne = m->ref.n_ext;
