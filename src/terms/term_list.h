@@ -10,8 +10,8 @@
 #define SPH_TERM_LIST(X)                                                       \
   X(angular_momentum_projection)                                               \
   X(jst_p)                                                                     \
-  X(jst_p_sym) X(jst_j) X(body_force) X(contact) X(essential_bc)               \
-      X(lagrange_projection)
+  X(jst_p_sym)                                                                 \
+  X(jst_j) X(body_force) X(contact) X(essential_bc) X(lagrange_projection)
 
 #ifndef SPH_TERM_LIST_EXTRA
 #define SPH_TERM_LIST_EXTRA(X)
