@@ -1,6 +1,8 @@
 /* Private state of the domain decomposition (issue 20), shared by the
- * fixed halo of the total-Lagrangian methods (domain.c) and the rebuilt
- * halo, migration and re-balancing of the updated-Lagrangian ones
+ * partition (domain.c), the fixed halo of the total-Lagrangian methods
+ * from the whole set (domain_fixed.c) or each rank's share
+ * (domain_share.c), the exchanges and reductions (domain_comm.c) and the
+ * rebuilt halo, migration and re-balancing of the updated-Lagrangian ones
  * (domain_dynamic.c). */
 #ifndef SPH_DOMAIN_IMPL_H
 #define SPH_DOMAIN_IMPL_H
