@@ -16,6 +16,7 @@
 
 #include "core/neighbors.h"
 #include "core/particles.h"
+#include "parallel/planes.h"
 #include "sph/status.h"
 
 typedef struct sph_domain sph_domain;
@@ -56,13 +57,6 @@ sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err);
 /* The ranks on this rank's node (sharing its memory; 1 without MPI). */
 int sph_domain_node_size(void);
 
-/* A symmetry or skew-symmetry plane X . n = at (axis: the coordinate axis of
- * n, or -1) whose mirror images the method builds over owned and ghost
- * particles (methods/tl_common.c). */
-typedef struct sph_domain_plane {
-  double n[3], at;
-  int axis;
-} sph_domain_plane;
 /* sph_domain_create for a run with mirror images: the ghosts are also the
  * particles within two supports of the owned ones or of their reflections
  * (chained over the planes, each within four supports of its plane), so a

@@ -382,7 +382,7 @@ static sph_status find_ghosts(sph_domain *d, sph_particles *ps, double radius,
     double w = y->depth * radius;
     if (y->np && q != d->rank) {
       memcpy(y->mbox, b, 6 * sizeof *b);
-      /* two passes, as the images are made (methods/tl_common.c) */
+      /* two passes, as the images are made (methods/common/images.c) */
       nb = sph_domain_mirror_boxes(y->planes, y->np, w + 2.0 * radius,
                                    1e-9 * radius, 2, y->mbox,
                                    SPH_DOMAIN_MIRROR_BOXES);

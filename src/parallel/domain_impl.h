@@ -1,6 +1,8 @@
 /* Private state of the domain decomposition (issue 20), shared by the
- * fixed halo of the total-Lagrangian methods (domain.c) and the rebuilt
- * halo, migration and re-balancing of the updated-Lagrangian ones
+ * partition (domain.c), the fixed halo of the total-Lagrangian methods
+ * from the whole set (domain_fixed.c) or each rank's share
+ * (domain_share.c), the exchanges and reductions (domain_comm.c) and the
+ * rebuilt halo, migration and re-balancing of the updated-Lagrangian ones
  * (domain_dynamic.c). */
 #ifndef SPH_DOMAIN_IMPL_H
 #define SPH_DOMAIN_IMPL_H
@@ -66,6 +68,12 @@ void sph_domain_rcb_counted(const double *X, const int64_t *t, size_t n,
 size_t sph_domain_mirror_boxes(const sph_domain_plane *planes, int np,
                                double near, double tol, int passes, double *box,
                                size_t max);
+
+/* domain_fixed.c: a halo larger than the domain (ng_support ghosts within
+ * one support of N particles): more ranks than useful; then the exchange's
+ * plan from the ghosts' owners gowner (collective, agreed; MPI only). */
+sph_status sph_domain_halo_plan(sph_domain *d, sph_status st, size_t ng_support,
+                                size_t N, const int *gowner, sph_error *err);
 
 /* domain_dynamic.c: the local capacity (owned + ghosts) for N particles
  * over R ranks; the dynamic state from the first partition (the particle

@@ -140,6 +140,12 @@ struct sph_sim {
 const sph_method_ops *sph_method_find(const char *name);
 /* NULL-terminated list of every method. */
 const sph_method_ops *const *sph_method_list(void);
+/* The names of the registry's methods (the first 15), ", " between them,
+ * into known (size bytes, truncated). */
+void sph_method_known(char *known, size_t size);
+/* The error of an unknown method name at node `at`: the closest known name
+ * ("did you mean"), else the names known. */
+sph_status sph_method_unknown(const char *name, sph_node *at, sph_error *err);
 
 /* Builds particles, looks up and sets up the method (its option errors point
  * into the scene file). */

@@ -120,7 +120,7 @@ static sph_status projection_rates(sph_term *term, sph_sim *sim,
   return SPH_OK;
 }
 
-static const sph_term_ops projection_ops = {
+const sph_term_ops angular_momentum_projection_term_ops = {
     .name = "angular_momentum_projection",
     .reference = "seed 000 sec. 6 eq. 45-48",
     .distributed = 1,
@@ -128,5 +128,6 @@ static const sph_term_ops projection_ops = {
 };
 
 sph_status angular_momentum_projection_create(sph_sim *sim, sph_error *err) {
-  return sph_sim_add_term(sim, &projection_ops, NULL, err);
+  return sph_sim_add_term(sim, &angular_momentum_projection_term_ops, NULL,
+                          err);
 }

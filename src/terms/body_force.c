@@ -22,7 +22,7 @@ static sph_status body_force_rates(sph_term *term, sph_sim *sim,
 
 static void body_force_destroy(sph_term *term) { free(term->data); }
 
-static const sph_term_ops body_force_ops = {
+const sph_term_ops body_force_term_ops = {
     .name = "body_force",
     .reference = "seed 000 eq. 27c",
     .distributed = 1,
@@ -37,7 +37,7 @@ sph_status body_force_create(sph_sim *sim, const double *rho0, sph_error *err) {
   f->rho0 = rho0;
   for (int c = 0; c < 3; ++c)
     f->g[c] = sim->scene->body_force[c];
-  sph_status st = sph_sim_add_term(sim, &body_force_ops, f, err);
+  sph_status st = sph_sim_add_term(sim, &body_force_term_ops, f, err);
   if (st != SPH_OK)
     free(f);
   return st;

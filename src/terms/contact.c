@@ -391,7 +391,7 @@ static void contact_destroy(sph_term *term) {
   free(ct);
 }
 
-static const sph_term_ops contact_ops = {
+const sph_term_ops contact_term_ops = {
     .name = "contact",
     .reference = "seed 001 sec. 2.4.2-2.4.3 (frictionless contact, penalty)",
     .distributed = 1,
@@ -490,7 +490,7 @@ sph_status contact_create(sph_sim *sim, const double *rho0, sph_error *err) {
       return st;
     }
   }
-  st = sph_sim_add_term(sim, &contact_ops, ct, err);
+  st = sph_sim_add_term(sim, &contact_term_ops, ct, err);
   if (st != SPH_OK)
     contact_destroy(&t);
   return st;

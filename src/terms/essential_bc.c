@@ -115,7 +115,7 @@ static void bc_destroy(sph_term *term) {
   free(e);
 }
 
-static const sph_term_ops essential_bc_ops = {
+const sph_term_ops essential_bc_term_ops = {
     .name = "essential_bc",
     .reference = "seed 000 Algorithm 1 step 8",
     .distributed = 1,
@@ -149,7 +149,7 @@ sph_status essential_bc_create(sph_sim *sim, const double *rho0,
     }
   }
   select_particles(e, sim);
-  sph_status st = sph_sim_add_term(sim, &essential_bc_ops, e, err);
+  sph_status st = sph_sim_add_term(sim, &essential_bc_term_ops, e, err);
   if (st != SPH_OK)
     bc_destroy(&t);
   return st;

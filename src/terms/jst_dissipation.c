@@ -139,7 +139,7 @@ static void jst_destroy(sph_term *term) {
   free(j);
 }
 
-static const sph_term_ops jst_p_ops = {
+const sph_term_ops jst_p_term_ops = {
     .name = "jst_dissipation_p",
     .reference = "seed 000 eq. 35-38, projection eq. 49",
     .distributed = 1,
@@ -147,7 +147,7 @@ static const sph_term_ops jst_p_ops = {
     .destroy = jst_destroy,
 };
 
-static const sph_term_ops jst_p_sym_ops = {
+const sph_term_ops jst_p_sym_term_ops = {
     .name = "jst_dissipation_p",
     .reference = "seed 004 eq. 27-28 (symmetrised)",
     .distributed = 1,
@@ -155,7 +155,7 @@ static const sph_term_ops jst_p_sym_ops = {
     .destroy = jst_destroy,
 };
 
-static const sph_term_ops jst_j_ops = {
+const sph_term_ops jst_j_term_ops = {
     .name = "jst_dissipation_J",
     .reference = "seed 000 eq. 35-38, projection eq. 51",
     .distributed = 1,
@@ -178,9 +178,9 @@ sph_status jst_dissipation_create(sph_sim *sim, const jst_params *p,
   }
   j->p = *p;
   sph_status st = sph_sim_add_term(sim,
-                                   p->ncomp == 1 ? &jst_j_ops
-                                   : p->lap_sym  ? &jst_p_sym_ops
-                                                 : &jst_p_ops,
+                                   p->ncomp == 1 ? &jst_j_term_ops
+                                   : p->lap_sym  ? &jst_p_sym_term_ops
+                                                 : &jst_p_term_ops,
                                    j, err);
   if (st != SPH_OK) {
     sph_term t = {.data = j};

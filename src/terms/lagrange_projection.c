@@ -351,7 +351,7 @@ static void lp_destroy(sph_term *term) {
   free(lp);
 }
 
-static const sph_term_ops lagrange_projection_ops = {
+const sph_term_ops lagrange_projection_term_ops = {
     .name = "lagrange_projection",
     .reference = "seed 000 App. B eq. B.1-B.6",
     .rates = lp_rates,
@@ -649,7 +649,8 @@ sph_status lagrange_projection_create(sph_sim *sim, const sph_cloud *cloud,
     }
   }
   lp_build_K(lp);
-  if ((st = sph_sim_add_term(sim, &lagrange_projection_ops, lp, err)) == SPH_OK)
+  if ((st = sph_sim_add_term(sim, &lagrange_projection_term_ops, lp, err)) ==
+      SPH_OK)
     return SPH_OK;
 fail:
   lp_destroy(&t);

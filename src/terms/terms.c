@@ -1,7 +1,9 @@
 /* The terms a method composes and the method's named timers (DESIGN.md
  * sec. 4): methods add them in setup; each rates / constrain hook is run in
- * order and timed for summary.json's terms. */
+ * order and timed for summary.json's terms; the list of every term's ops
+ * table (term_list.h). */
 #include "solver/sim.h"
+#include "terms/terms_impl.h"
 
 #include <string.h>
 
@@ -60,3 +62,10 @@ sph_status sph_sim_terms_renumber(sph_sim *sim, sph_error *err) {
       SPH_TRY(sim->terms[i].ops->renumber(&sim->terms[i], sim, err));
   return SPH_OK;
 }
+
+#define SPH_TERM_ENTRY(id) &id##_term_ops,
+static const sph_term_ops *const terms[] = {
+    SPH_TERM_LIST(SPH_TERM_ENTRY) SPH_TERM_LIST_EXTRA(SPH_TERM_ENTRY) NULL};
+#undef SPH_TERM_ENTRY
+
+const sph_term_ops *const *sph_term_list(void) { return terms; }

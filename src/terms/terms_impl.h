@@ -8,6 +8,15 @@
 
 #include "core/neighbors.h"
 #include "solver/sim.h"
+#include "terms/term_list.h"
+
+#define SPH_TERM_EXTERN(id) extern const sph_term_ops id##_term_ops;
+SPH_TERM_LIST(SPH_TERM_EXTERN)
+SPH_TERM_LIST_EXTRA(SPH_TERM_EXTERN)
+#undef SPH_TERM_EXTERN
+
+/* NULL-terminated list of every term's ops table (term_list.h). */
+const sph_term_ops *const *sph_term_list(void);
 
 /* Projects a per-particle vector field w (3 per particle, e.g. the internal
  * forces) so that sum V w = 0 and sum V X x w = 0 over each body, in the

@@ -18,6 +18,7 @@
 #include "scene/scene.h"
 #include "solver/run.h"
 #include "solver/sim.h"
+#include "terms/terms_impl.h"
 
 static sph_sim *make_sim(const char *method, const char *velocity,
                          sph_scene **scene) {
@@ -192,6 +193,30 @@ START_TEST(runs_repeat) {
 }
 END_TEST
 
+/* the registries made from the X-macro lists (methods/method_list.h,
+ * terms/term_list.h): every entry named and referenced, and the
+ * unknown-method error's list of names */
+START_TEST(registries_are_whole) {
+  char known[256] = "";
+  sph_method_known(known, sizeof known);
+  ck_assert_str_eq(known, "tl-jst, tl-csph, ul-sph, ul-csph, tl-bond");
+  sph_error err;
+  ck_assert_int_eq(sph_method_unknown("zzzzzzzzzzzz", NULL, &err), SPH_ERR_ARG);
+  ck_assert_msg(strstr(err.message, "unknown method 'zzzzzzzzzzzz' (known: "
+                                    "tl-jst, tl-csph, ul-sph, ul-csph, "
+                                    "tl-bond)") != NULL,
+                "%s", err.message);
+  int nterms = 0;
+  for (const sph_term_ops *const *t = sph_term_list(); *t; ++t, ++nterms) {
+    ck_assert_msg((*t)->name && *(*t)->name, "a term without a name");
+    ck_assert_msg((*t)->reference && *(*t)->reference, "%s: no reference",
+                  (*t)->name);
+    ck_assert_msg((*t)->rates || (*t)->constrain, "%s: no hook", (*t)->name);
+  }
+  ck_assert_int_eq(nterms, 8);
+}
+END_TEST
+
 int main(void) {
   Suite *s = suite_create("conformance");
   TCase *tc = tcase_create("every method");
@@ -201,6 +226,7 @@ int main(void) {
   tcase_add_test(tc, translation_stays_rigid);
   tcase_add_test(tc, free_body_conserves_momentum);
   tcase_add_test(tc, runs_repeat);
+  tcase_add_test(tc, registries_are_whole);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }

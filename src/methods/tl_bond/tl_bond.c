@@ -33,7 +33,7 @@
 
 /* F^c of the real particles (eq. 37-39) */
 static void bond_defgrad_owned(tl_bond *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
@@ -50,11 +50,11 @@ static void bond_defgrad_owned(tl_bond *m, long n) {
 /* the same mirrored onto the images (over MPI ranks those of ghosts from
  * the ghosts' F^c) */
 static sph_status bond_defgrad(tl_bond *m, long n, sph_error *err) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   bond_defgrad_owned(m, n);
-  SPH_TRY(tl_image_sources(m->sim, ref, m->Fc, 9, err));
+  SPH_TRY(sph_mirror_sources(m->sim, ref, m->Fc, 9, err));
   if (ref->n_ext > ref->n)
-    tl_mirror_refresh(ref, m->x, m->p, m->Fc, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->Fc, NULL, NULL);
   return SPH_OK;
 }
 
@@ -63,15 +63,15 @@ static sph_status bond_defgrad(tl_bond *m, long n, sph_error *err) {
  * their owners) */
 static sph_status deformation_and_stress(tl_bond *m, const double **Fs,
                                          sph_error *err) {
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   sph_domain *d = m->sim->domain;
   long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
   SPH_TRY(sph_domain_exchange(d, m->x, 3, err));
   SPH_TRY(sph_domain_exchange(d, m->p, 3, err));
   if (!m->bond) /* the images' stress is at their F */
-    SPH_TRY(tl_image_sources(m->sim, ref, m->F, 9, err));
+    SPH_TRY(sph_mirror_sources(m->sim, ref, m->F, 9, err));
   if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
   *Fs = m->F;
   if (m->bond) {
     SPH_TRY(bond_defgrad(m, n, err));
@@ -94,7 +94,7 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
                               sph_error *err) {
   tl_bond *m = ctx;
   sph_sim *sim = m->sim;
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   long n = (long)ref->n;
   double t0 = sph_wtime();
@@ -122,12 +122,12 @@ static sph_status tl_bond_rhs(void *ctx, int stage, double t, double dt,
       m->dx[3 * a + c] = va[c];
     }
   }
-  return tl_rates_terms(sim, ref, m->dp, m->timer_force, t0, t, err);
+  return sph_step_rates_terms(sim, ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status tl_bond_constrain(void *ctx, double t, sph_error *err) {
   tl_bond *m = ctx;
-  return tl_constrain_terms(m->sim, &m->ref, t, err);
+  return sph_step_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 /* ---- ops
@@ -137,16 +137,16 @@ static sph_status tl_bond_constrain(void *ctx, double t, sph_error *err) {
  * eq. 32 from the smallest principal stretches of F (or c_p^Lin) */
 static double tl_bond_stable_dt(sph_sim *sim) {
   tl_bond *m = sim->method_data;
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
   /* over MPI ranks the pairs read the ghosts' x and stretches, the images
    * of ghosts the ghosts' x and F */
   if (sph_domain_exchange(sim->domain, m->x, 3, NULL) != SPH_OK ||
-      (m->pair_speed && tl_image_sources(sim, ref, m->F, 9, NULL) != SPH_OK))
+      (m->pair_speed && sph_mirror_sources(sim, ref, m->F, 9, NULL) != SPH_OK))
     return NAN;
   if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
   double lam_min = 1.0;
   if (m->pair_speed) {
     lam_min = INFINITY;
@@ -183,34 +183,34 @@ static double tl_bond_stable_dt(sph_sim *sim) {
 
 static sph_status tl_bond_step(sph_sim *sim, double dt, sph_error *err) {
   tl_bond *m = sim->method_data;
-  return tl_rk_step(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
-                    dt, err);
+  return sph_step_rk(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
+                     dt, err);
 }
 
 static sph_status tl_bond_derive(sph_sim *sim, sph_error *err) {
   tl_bond *m = sim->method_data;
   const double *Fs;
   SPH_TRY(deformation_and_stress(m, &Fs, err));
-  tl_derive(sim, &m->ref, NULL, NULL, Fs);
-  return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
+  sph_ref_derive(sim, &m->ref, NULL, NULL, Fs);
+  return sph_step_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
 
 /* strain energy at the F the stress is evaluated at */
 static void tl_bond_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_bond *m = sim->method_data;
-  tl_reference r = m->ref;
+  sph_ref r = m->ref;
   if (m->bond) {
     bond_defgrad_owned(m, (long)r.n);
     r.F = m->Fc;
   }
-  tl_energy(sim, &r, NULL, NULL, kinetic, strain);
+  sph_ref_energy(sim, &r, NULL, NULL, kinetic, strain);
 }
 
 static void tl_bond_destroy(sph_sim *sim) {
   tl_bond *m = sim->method_data;
   if (!m)
     return;
-  tl_reference_destroy(&m->ref);
+  sph_ref_destroy(&m->ref);
   double *arrays[] = {m->v,       m->gv, m->fa, m->fb,  m->q,  m->lap,
                       m->lap_sym, m->Mc, m->Fc, m->lam, m->x0, m->p0,
                       m->F0,      m->dx, m->dp, m->dF};
@@ -232,11 +232,12 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
  * configuration */
 static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
                                int symmetric, int need_lap, sph_error *err) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   size_t ne = ref->n_ext, count = nl->count;
   /* over MPI ranks the ghosts' rows are not whole: their slots toward this
-   * rank's particles come from their owners' coefficients (tl_ghost_slots) */
+   * rank's particles come from their owners' coefficients (sph_ref_ghost_slots)
+   */
   sph_cloud cloud = {.n = ref->n_img,
                      .partial = ref->partial,
                      .dim = sim->scene->dimension,
@@ -253,14 +254,15 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
       (st = alloc_zero(&w, count, err)) != SPH_OK ||
       (st = alloc_zero(&wself, ne, err)) != SPH_OK ||
       (need_lap && (st = alloc_zero(&lap, count, err)) != SPH_OK) ||
-      (st = tl_reference_reverse_slots(ref, &rev, err)) != SPH_OK ||
+      (st = sph_ref_reverse_slots(ref, &rev, err)) != SPH_OK ||
       (st = sph_correction_gradient(&cloud, kind, g, NULL, NULL, err)) !=
           SPH_OK ||
       (st = sph_correction_kernel(&cloud, first_order ? 1 : 0, w, wself,
                                   err)) != SPH_OK ||
       (need_lap &&
        (st = sph_correction_laplacian(&cloud, lap, err)) != SPH_OK) ||
-      (st = tl_ghost_slots(sim, ref, &cloud, kind, rev, g, lap, err)) != SPH_OK)
+      (st = sph_ref_ghost_slots(sim, ref, &cloud, kind, rev, g, lap, err)) !=
+          SPH_OK)
     goto done;
   for (size_t a = 0; a < cloud.n; ++a) {
     double *M = m->Mc + 9 * a;
@@ -301,19 +303,23 @@ done:
   return st;
 }
 
-static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct tl_bond_options {
+  int bond;        /* deformation_gradient: bond (else average) */
+  int first_order; /* correction: first_order (else zeroth_order) */
+  int symmetric;   /* force: symmetric (else conservative) */
+  int pair_speed;  /* wave_speed: pair (else linear) */
+  sph_rk_step integrate;
+  double cfl;
+  double e2p, e4p; /* JST on p */
+} tl_bond_options;
+
+static sph_status tl_bond_options_parse(sph_node *opt, tl_bond_options *o,
+                                        sph_error *err) {
   static const char *const keys[] = {
       "name", "deformation_gradient", "correction", "force", "integrator",
       "cfl",  "wave_speed",           "jst",        NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  tl_bond *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "tl-bond");
-  sim->method_data = m;
-  m->sim = sim;
-  size_t n = sim->ps->n;
-
-  /* options */
   static const char *const defgrads[] = {"bond", "average", NULL};
   static const char *const corrections[] = {"first_order", "zeroth_order",
                                             NULL};
@@ -329,31 +335,50 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_node_get_choice(opt, "integrator", integrators, "ssp-rk3", &integ,
                               err));
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "pair", &ws, err));
-  m->bond = dg == 0;
-  m->pair_speed = ws == 0;
-  m->integrate = integ == 0 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.9, &m->cfl, err));
+  o->bond = dg == 0;
+  o->first_order = corr == 0;
+  o->symmetric = fo == 0;
+  o->pair_speed = ws == 0;
+  o->integrate = integ == 0 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.9, &o->cfl, err));
   /* both integrators are SSP with coefficient 1: stable up to the forward
    * Euler limit, CFL 1 (seed 004 runs up to 0.9) */
-  if (!(m->cfl > 0.0 && m->cfl <= 1.0))
+  if (!(o->cfl > 0.0 && o->cfl <= 1.0))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
                           "cfl must be in (0, 1] (the SSP limit of %s), got %g",
-                          integrators[integ], m->cfl);
+                          integrators[integ], o->cfl);
   sph_node *jst;
   SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
   if (jst->kind != SPH_NODE_MAP)
     return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
   static const char *const jkeys[] = {"eps2_p", "eps4_p", NULL};
   SPH_TRY(sph_node_check_keys(jst, jkeys, err));
-  double e2p, e4p;
-  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
-  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
-  if (e2p < 0.0 || e4p < 0.0)
-    return sph_node_error(sph_node_child(jst, e2p < 0.0 ? "eps2_p" : "eps4_p"),
-                          err, SPH_ERR_RANGE, "JST coefficients must be >= 0");
+  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &o->e2p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &o->e4p, err));
+  if (o->e2p < 0.0 || o->e4p < 0.0)
+    return sph_node_error(
+        sph_node_child(jst, o->e2p < 0.0 ? "eps2_p" : "eps4_p"), err,
+        SPH_ERR_RANGE, "JST coefficients must be >= 0");
+  return SPH_OK;
+}
+
+static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  tl_bond_options o = {0};
+  SPH_TRY(tl_bond_options_parse(opt, &o, err));
+  tl_bond *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-bond");
+  sim->method_data = m;
+  m->sim = sim;
+  size_t n = sim->ps->n;
+  m->bond = o.bond;
+  m->pair_speed = o.pair_speed;
+  m->integrate = o.integrate;
+  m->cfl = o.cfl;
+  double e2p = o.e2p, e4p = o.e4p;
 
   /* reference configuration with images across symmetry planes, state */
-  SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
+  SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
   size_t ne = m->ref.n_ext, count = m->ref.nl->count;
   m->x = m->ref.x;
   m->p = m->ref.p;
@@ -374,7 +399,7 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     SPH_TRY(alloc_zero(&m->Fc, 9 * ne, err));
   if (m->pair_speed)
     SPH_TRY(alloc_zero(&m->lam, ne, err));
-  SPH_TRY(pair_weights(m, sim, corr == 0, fo == 0, need_lap, err));
+  SPH_TRY(pair_weights(m, sim, o.first_order, o.symmetric, need_lap, err));
   m->cp_now = m->ref.cp;
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");
@@ -402,13 +427,13 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .cp_now = m->pair_speed ? &m->cp_now : NULL};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
-  return tl_essential_bc_attach(sim, &m->ref, tl_bond_constrain, m, err);
+  SPH_TRY(sph_step_external_terms(sim, &m->ref, err));
+  return sph_step_essential_bc(sim, &m->ref, tl_bond_constrain, m, err);
 }
 
 static int tl_bond_state(sph_sim *sim, sph_state_array *out) {
   tl_bond *m = sim->method_data;
-  return tl_state_xpF(&m->ref, out);
+  return sph_step_state_xpF(&m->ref, out);
 }
 
 const sph_method_ops tl_bond_method_ops = {
@@ -419,7 +444,7 @@ const sph_method_ops tl_bond_method_ops = {
                  "37-39",
     .conserves_angular_momentum = 0,
     .distributed = 1,
-    .fields = TL_OUTPUT_FIELDS,
+    .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = tl_bond_setup,
     .stable_dt = tl_bond_stable_dt,
     .step = tl_bond_step,

@@ -3,12 +3,12 @@
 #define SPH_TL_BOND_IMPL_H
 
 #include "integrators/integrator_impl.h"
-#include "methods/tl_common_impl.h"
+#include "methods/common/common_impl.h"
 
 typedef struct tl_bond {
-  tl_reference ref; /* neighbours, volumes, materials, images */
-  int bond;         /* stress at the bond-based F^c (eq. 37-39), else at F */
-  int pair_speed;   /* c_p,ij of eq. 32 in dt and JST, else c_p^Lin */
+  sph_ref ref;    /* neighbours, volumes, materials, images */
+  int bond;       /* stress at the bond-based F^c (eq. 37-39), else at F */
+  int pair_speed; /* c_p,ij of eq. 32 in dt and JST, else c_p^Lin */
   double cfl;
   double cp_now; /* largest c_p,ij of the step (the JST's c_p) */
   sph_rk_step integrate;

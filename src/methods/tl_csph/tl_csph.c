@@ -17,32 +17,32 @@
 /* F from positions for the particles, images mirrored, ghosts' from their
  * owners, P for every point */
 static sph_status deformation_and_stress(tl_csph *m, long n, sph_error *err) {
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   long ne = (long)ref->n_ext;
   int dim = m->sim->scene->dimension;
   SPH_TRY(sph_domain_exchange(m->sim->domain, m->x, 3, err));
   if (ne > n) /* image positions and momenta from their sources */
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    tl_sums s; /* F = grad_0 x (seed 001 eq. 9) */
-    tl_pair_sums(ref, (size_t)a, m->x, 0, NULL, &s);
+    ref_sums s; /* F = grad_0 x (seed 001 eq. 9) */
+    sph_ref_pair_sums(ref, (size_t)a, m->x, 0, NULL, &s);
     double F[9], unused[3];
-    tl_sums_store(&s, F, unused);
-    tl_iact_gradient_correct(F, ref->L + 9 * a);
-    tl_iact_plane_strain(F, dim);
+    ref_sums_store(&s, F, unused);
+    ref_iact_gradient_correct(F, ref->L + 9 * a);
+    ref_iact_plane_strain(F, dim);
     memcpy(m->F + 9 * a, F, sizeof F);
   }
   SPH_TRY(sph_domain_exchange(m->sim->domain, m->F, 9, err));
   if (ne > n) /* the images' F mirror their sources' */
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];
     sph_mat3_cofactor(m->F + 9 * a, H);
     sph_material_stress(ref->mat[a], m->F + 9 * a, H,
                         sph_mat3_det(m->F + 9 * a), m->P + 9 * a);
-    tl_force_matrix(ref, (size_t)a);
+    sph_ref_force_matrix(ref, (size_t)a);
   }
   return SPH_OK;
 }
@@ -53,63 +53,78 @@ static sph_status tl_csph_rates(void *ctx, double t, sph_error *err) {
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   SPH_TRY(deformation_and_stress(m, n, err));
-  tl_conservative_force(&m->ref, m->dp);
-  return tl_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
+  sph_ref_conservative_force(&m->ref, m->dp);
+  return sph_step_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status tl_csph_constrain(void *ctx, double t, sph_error *err) {
   tl_csph *m = ctx;
-  return tl_constrain_terms(m->sim, &m->ref, t, err);
+  return sph_step_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 static double tl_csph_stable_dt(sph_sim *sim) {
   const tl_csph *m = sim->method_data;
-  return tl_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
+  return sph_ref_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
 }
 
 static sph_status tl_csph_step(sph_sim *sim, double dt, sph_error *err) {
   tl_csph *m = sim->method_data;
-  return tl_leapfrog_step(sim, &m->ref, &m->lf, m->timer_integration, dt, err);
+  return sph_step_leapfrog(sim, &m->ref, &m->lf, m->timer_integration, dt, err);
 }
 
 static sph_status tl_csph_derive(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
   SPH_TRY(deformation_and_stress(m, (long)sim->ps->n, err));
-  return tl_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
+  return sph_step_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
 }
 
 static void tl_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_csph *m = sim->method_data;
-  tl_energy(sim, &m->ref, NULL, NULL, kinetic, strain);
+  sph_ref_energy(sim, &m->ref, NULL, NULL, kinetic, strain);
 }
 
 static void tl_csph_destroy(sph_sim *sim) {
   tl_csph *m = sim->method_data;
   if (!m)
     return;
-  tl_reference_destroy(&m->ref);
+  sph_ref_destroy(&m->ref);
   free(m->dp);
   free(m);
   sim->method_data = NULL;
 }
 
-static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct tl_csph_options {
+  double cfl;
+  int current_wave_speed; /* dt from the current state's c_p */
+} tl_csph_options;
+
+static sph_status tl_csph_options_parse(sph_node *opt, tl_csph_options *o,
+                                        sph_error *err) {
   static const char *const keys[] = {"name", "cfl", "integrator", "wave_speed",
                                      NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  tl_csph *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph");
-  sim->method_data = m;
-  m->sim = sim;
-  SPH_TRY(tl_leapfrog_options(opt, &m->cfl, err));
+  SPH_TRY(sph_step_leapfrog_options(opt, &o->cfl, err));
   const char *ws;
   SPH_TRY(sph_node_get_string(opt, "wave_speed", 0, "current", &ws, err));
   if (strcmp(ws, "current") && strcmp(ws, "reference"))
     return sph_node_error(sph_node_child(opt, "wave_speed"), err, SPH_ERR_RANGE,
                           "'%s' is not one of: current, reference", ws);
-  m->current_wave_speed = !strcmp(ws, "current");
-  SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
+  o->current_wave_speed = !strcmp(ws, "current");
+  return SPH_OK;
+}
+
+static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  tl_csph_options o = {0};
+  SPH_TRY(tl_csph_options_parse(opt, &o, err));
+  tl_csph *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph");
+  sim->method_data = m;
+  m->sim = sim;
+  m->cfl = o.cfl;
+  m->current_wave_speed = o.current_wave_speed;
+  SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
   sph_particles *ps = sim->ps;
   m->x = m->ref.x;
   m->p = m->ref.p;
@@ -120,19 +135,19 @@ static sph_status tl_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_error_set(err, SPH_ERR_NOMEM, "tl-csph rates");
   m->timer_force = sph_sim_add_timer(sim, "internal_force");
   m->timer_integration = sph_sim_add_timer(sim, "time_integration");
-  return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, tl_csph_rates,
-                            tl_csph_constrain, m, err);
+  return sph_step_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, tl_csph_rates,
+                                  tl_csph_constrain, m, err);
 }
 
 static int tl_csph_state(sph_sim *sim, sph_state_array *out) {
   tl_csph *m = sim->method_data;
   /* F of the last rates: the next time step's wave speed reads it */
-  return tl_state_xpF(&m->ref, out);
+  return sph_step_state_xpF(&m->ref, out);
 }
 
 static sph_status tl_csph_restore(sph_sim *sim, sph_error *err) {
   tl_csph *m = sim->method_data;
-  return tl_leapfrog_restore(sim, &m->lf, err);
+  return sph_step_leapfrog_restore(sim, &m->lf, err);
 }
 
 const sph_method_ops tl_csph_method_ops = {
@@ -141,7 +156,7 @@ const sph_method_ops tl_csph_method_ops = {
     .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 2, eq. 8-11",
     .conserves_angular_momentum = 1,
     .distributed = 1,
-    .fields = TL_OUTPUT_FIELDS,
+    .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = tl_csph_setup,
     .stable_dt = tl_csph_stable_dt,
     .step = tl_csph_step,

@@ -3,10 +3,10 @@
 #define SPH_TL_CSPH_IMPL_H
 
 #include "integrators/integrator_impl.h"
-#include "methods/tl_common_impl.h"
+#include "methods/common/common_impl.h"
 
 typedef struct tl_csph {
-  tl_reference ref;
+  sph_ref ref;
   double cfl;
   int current_wave_speed; /* dt from the current state's c_p */
   double *x, *p, *F, *P;  /* particle fields */

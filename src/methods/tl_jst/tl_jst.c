@@ -14,8 +14,8 @@
 
 #include "core/corrections.h"
 #include "core/tensor.h"
+#include "methods/common/pair_iact.h"
 #include "methods/registry_impl.h"
-#include "methods/tl_iact.h"
 #include "methods/tl_jst/tl_jst_iact.h"
 #include "methods/tl_jst/tl_jst_impl.h"
 #include "terms/terms_impl.h"
@@ -38,9 +38,9 @@ static inline void strain_measures(const tl_jst *m, const double *F,
 /* mirror images take their sources' state */
 static void refresh_images(tl_jst *m) {
   if (m->ref.n_ext > m->ref.n)
-    tl_mirror_refresh(&m->ref, m->x, m->p, m->F,
-                      m->fields == TL_JST_PFHJ ? m->H : NULL,
-                      m->fields == TL_JST_PF ? NULL : m->J);
+    sph_mirror_state(&m->ref, m->x, m->p, m->F,
+                     m->fields == TL_JST_PFHJ ? m->H : NULL,
+                     m->fields == TL_JST_PF ? NULL : m->J);
 }
 
 /* P, and Q = P L for the conservative force, of every point; the
@@ -57,7 +57,7 @@ static void compute_stress(tl_jst *m, long n, int store_P) {
     if (store_P)
       memcpy(m->P + 9 * a, P, sizeof P);
     if (conservative)
-      tl_force_matrix_of(&m->ref, (size_t)a, P);
+      sph_ref_force_matrix_of(&m->ref, (size_t)a, P);
   }
 }
 
@@ -69,7 +69,7 @@ static void compute_stress(tl_jst *m, long n, int store_P) {
 static inline void particle_rates(tl_jst *m, size_t a, double G[9],
                                   const double dp[3]) {
   double inv_rho0 = 1.0 / m->ref.rho0[a];
-  tl_iact_gradient_correct(G, m->ref.L + 9 * a);
+  ref_iact_gradient_correct(G, m->ref.L + 9 * a);
   for (int k = 0; k < 9; ++k)
     G[k] *= inv_rho0;
   memcpy(m->dF + 9 * a, G, 9 * sizeof *G);
@@ -89,12 +89,12 @@ static inline void particle_rates(tl_jst *m, size_t a, double G[9],
 /* particle a's share of sweep_conservative; with `lap`, also L[p] */
 static inline __attribute__((always_inline)) void
 conservative_particle(tl_jst *m, size_t a, const double *lap) {
-  const tl_reference *ref = &m->ref;
-  tl_sums s;
-  tl_pair_sums(ref, a, m->p, 1, lap, &s);
+  const sph_ref *ref = &m->ref;
+  ref_sums s;
+  sph_ref_pair_sums(ref, a, m->p, 1, lap, &s);
   double G[9], f[3], self[3];
-  tl_sums_store(&s, G, f);
-  tl_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
+  ref_sums_store(&s, G, f);
+  ref_iact_force_self(ref->Qt + 9 * a, ref->s + 3 * a, self);
   for (int c = 0; c < 3; ++c)
     f[c] += self[c];
   particle_rates(m, a, G, f);
@@ -122,7 +122,7 @@ static void sweep_conservative(tl_jst *m, long n) {
 /* the symmetric force of seed 003 eq. 11 with the corrected gradient, or
  * (eq. 30) with the uncorrected one */
 static void sweep_symmetric(tl_jst *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   int corrected = m->force == TL_JST_SYMMETRIC;
 #pragma omp parallel for schedule(static)
@@ -132,8 +132,8 @@ static void sweep_symmetric(tl_jst *m, long n) {
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
       double r[3], g[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      ref_iact_pair_vector(ref->X, (size_t)a, b, r);
+      ref_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
       for (int c = 0; c < 3; ++c)
         r[c] *= ref->w[k];
       if (corrected)
@@ -149,7 +149,7 @@ static void sweep_symmetric(tl_jst *m, long n) {
 
 /* the kernel-gradient force of seed 000 eq. 31 */
 static void sweep_eq31(tl_jst *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   const double *V = ref->V;
 #pragma omp parallel for schedule(static)
@@ -159,8 +159,8 @@ static void sweep_eq31(tl_jst *m, long n) {
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
       double r[3];
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
-      tl_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
+      ref_iact_pair_vector(ref->X, (size_t)a, b, r);
+      ref_iact_gradient(G, ref->w[k], pa, m->p + 3 * b, r);
       tl_jst_iact_force_kernel(T, V[b], m->P + 9 * b, m->fgrad + 3 * m->rev[k]);
     }
     /* the b = a term of eq. 31 */
@@ -179,11 +179,11 @@ static sph_status tl_jst_rhs(void *ctx, int stage, double t, double dt,
   /* over MPI ranks the sweep reads the ghosts' p and Q (or P), which their
    * owners compute; images of ghosts mirror the ghosts' p, F, H and J */
   SPH_TRY(sph_domain_exchange(sim->domain, m->p, 3, err));
-  SPH_TRY(tl_image_sources(sim, &m->ref, m->F, 9, err));
+  SPH_TRY(sph_mirror_sources(sim, &m->ref, m->F, 9, err));
   if (m->fields == TL_JST_PFHJ)
-    SPH_TRY(tl_image_sources(sim, &m->ref, m->H, 9, err));
+    SPH_TRY(sph_mirror_sources(sim, &m->ref, m->H, 9, err));
   if (m->fields != TL_JST_PF)
-    SPH_TRY(tl_image_sources(sim, &m->ref, m->J, 1, err));
+    SPH_TRY(sph_mirror_sources(sim, &m->ref, m->J, 1, err));
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_img, 0);
   if (m->force == TL_JST_CONSERVATIVE)
@@ -231,35 +231,35 @@ static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
 
 static double tl_jst_stable_dt(sph_sim *sim) {
   tl_jst *m = sim->method_data;
-  return tl_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
+  return sph_ref_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
 }
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
   tl_jst *m = sim->method_data;
-  return tl_rk_step(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
-                    dt, err);
+  return sph_step_rk(sim, &m->ref, &m->ode, m->integrate, m->timer_integration,
+                     dt, err);
 }
 
 static sph_status tl_jst_derive(sph_sim *sim, sph_error *err) {
   tl_jst *m = sim->method_data;
   refresh_images(m);
   compute_stress(m, (long)m->ref.n_img, 1);
-  tl_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
-            m->fields == TL_JST_PF ? NULL : m->J, NULL);
-  return tl_rk_acceleration(sim, &m->ref, &m->ode, err);
+  sph_ref_derive(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
+                 m->fields == TL_JST_PF ? NULL : m->J, NULL);
+  return sph_step_rk_acceleration(sim, &m->ref, &m->ode, err);
 }
 
 static void tl_jst_energy(sph_sim *sim, double *kinetic, double *strain) {
   tl_jst *m = sim->method_data;
-  tl_energy(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
-            m->fields == TL_JST_PF ? NULL : m->J, kinetic, strain);
+  sph_ref_energy(sim, &m->ref, m->fields == TL_JST_PFHJ ? m->H : NULL,
+                 m->fields == TL_JST_PF ? NULL : m->J, kinetic, strain);
 }
 
 static void tl_jst_destroy(sph_sim *sim) {
   tl_jst *m = sim->method_data;
   if (!m)
     return;
-  tl_reference_destroy(&m->ref);
+  sph_ref_destroy(&m->ref);
   free(m->H);
   free(m->lap);
   free(m->lu_p);
@@ -289,7 +289,50 @@ static sph_status alloc_zero(double **p, size_t count, sph_error *err) {
   return *p ? SPH_OK : sph_error_set(err, SPH_ERR_NOMEM, "tl-jst arrays");
 }
 
-static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct tl_jst_options {
+  tl_jst_fields fields;
+  tl_jst_force force;
+  int gradient_laplacian; /* laplacian: gradient (else corrected) */
+  sph_rk_step integrate;
+  int lagrange;          /* essential_bc: lagrange (else direct) */
+  int lagrange_momentum; /* the total momentum rows of the projection */
+  int current_wave_speed;
+  double cfl;
+  int amp, jproj; /* angular momentum and JST projections */
+  double e2p, e4p, e2j, e4j;
+} tl_jst_options;
+
+/* The `jst` block's coefficients into o (fields already parsed). */
+static sph_status jst_options_parse(sph_node *opt, tl_jst_options *o,
+                                    sph_error *err) {
+  sph_node *jst;
+  SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
+  if (jst->kind != SPH_NODE_MAP)
+    return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
+  static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
+                                      NULL};
+  SPH_TRY(sph_node_check_keys(jst, jkeys, err));
+  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &o->e2p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &o->e4p, err));
+  SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &o->e2j, err));
+  SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &o->e4j, err));
+  if (o->fields == TL_JST_PF && (o->e2j != 0.0 || o->e4j != 0.0))
+    return sph_node_error(
+        sph_node_child(jst, o->e2j != 0.0 ? "eps2_J" : "eps4_J"), err,
+        SPH_ERR_ARG,
+        "fields pF has no J equation; use fields pFJ or "
+        "pFHJ for JST on J, or set it to 0");
+  double eps[4] = {o->e2p, o->e4p, o->e2j, o->e4j};
+  for (int i = 0; i < 4; ++i)
+    if (eps[i] < 0.0)
+      return sph_node_error(jst, err, SPH_ERR_RANGE,
+                            "JST coefficients must be >= 0");
+  return SPH_OK;
+}
+
+static sph_status tl_jst_options_parse(sph_node *opt, tl_jst_options *o,
+                                       sph_error *err) {
   static const char *const keys[] = {"name",
                                      "fields",
                                      "force",
@@ -304,141 +347,87 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                                      "lagrange_momentum",
                                      NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  tl_jst *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "tl-jst");
-  sim->method_data = m;
-  m->sim = sim;
-  const sph_scene *s = sim->scene;
-  sph_particles *ps = sim->ps;
-  size_t n = ps->n;
-
-  /* options */
   static const char *const fields[] = {"pF", "pFJ", "pFHJ", NULL};
   static const char *const forces[] = {"conservative", "symmetric", "eq30",
                                        "eq31", NULL};
   static const char *const laps[] = {"corrected", "gradient", NULL};
   static const char *const integrators[] = {"tvd-rk2", "ssp-rk3", NULL};
   static const char *const bcs[] = {"direct", "lagrange", NULL};
-  int f, fo, lp, integ, bc, amp, jproj;
+  int f, fo, lp, integ, bc;
   SPH_TRY(sph_node_get_choice(opt, "fields", fields, "pF", &f, err));
   SPH_TRY(sph_node_get_choice(opt, "force", forces, "conservative", &fo, err));
   SPH_TRY(sph_node_get_choice(opt, "laplacian", laps, "corrected", &lp, err));
   SPH_TRY(sph_node_get_choice(opt, "integrator", integrators, "tvd-rk2", &integ,
                               err));
   SPH_TRY(sph_node_get_choice(opt, "essential_bc", bcs, "direct", &bc, err));
-  int lagrange_momentum;
-  SPH_TRY(sph_node_get_bool(opt, "lagrange_momentum", 0, 0, &lagrange_momentum,
-                            err));
-  if (lagrange_momentum && bc != 1)
+  SPH_TRY(sph_node_get_bool(opt, "lagrange_momentum", 0, 0,
+                            &o->lagrange_momentum, err));
+  if (o->lagrange_momentum && bc != 1)
     return sph_node_error(sph_node_child(opt, "lagrange_momentum"), err,
                           SPH_ERR_ARG,
                           "lagrange_momentum needs essential_bc: lagrange");
   static const char *const speeds[] = {"current", "reference", NULL};
   int ws;
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "current", &ws, err));
-  m->current_wave_speed = ws == 0;
-  m->integrate = integ == 1 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
-  m->fields = (tl_jst_fields)f;
-  m->force = (tl_jst_force)fo;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &m->cfl, err));
-  if (!(m->cfl > 0.0 && m->cfl <= 1.5))
+  o->current_wave_speed = ws == 0;
+  o->integrate = integ == 1 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
+  o->fields = (tl_jst_fields)f;
+  o->force = (tl_jst_force)fo;
+  o->gradient_laplacian = lp == 1;
+  o->lagrange = bc == 1;
+  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.3, &o->cfl, err));
+  if (!(o->cfl > 0.0 && o->cfl <= 1.5))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
-                          "cfl must be in (0, 1.5], got %g", m->cfl);
-  SPH_TRY(
-      sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &amp, err));
-  SPH_TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &jproj, err));
-  sph_node *jst;
-  SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
-  if (jst->kind != SPH_NODE_MAP)
-    return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
-  static const char *const jkeys[] = {"eps2_p", "eps4_p", "eps2_J", "eps4_J",
-                                      NULL};
-  SPH_TRY(sph_node_check_keys(jst, jkeys, err));
-  double e2p, e4p, e2j, e4j;
-  SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2p, err));
-  SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4p, err));
-  SPH_TRY(sph_node_get_double(jst, "eps2_J", 0, 0.0, &e2j, err));
-  SPH_TRY(sph_node_get_double(jst, "eps4_J", 0, 0.0, &e4j, err));
-  if (m->fields == TL_JST_PF && (e2j != 0.0 || e4j != 0.0))
-    return sph_node_error(sph_node_child(jst, e2j != 0.0 ? "eps2_J" : "eps4_J"),
-                          err, SPH_ERR_ARG,
-                          "fields pF has no J equation; use fields pFJ or "
-                          "pFHJ for JST on J, or set it to 0");
-  double eps[4] = {e2p, e4p, e2j, e4j};
-  for (int i = 0; i < 4; ++i)
-    if (eps[i] < 0.0)
-      return sph_node_error(jst, err, SPH_ERR_RANGE,
-                            "JST coefficients must be >= 0");
-  /* reference configuration (with mirror images) and the state */
-  SPH_TRY(tl_reference_create(&m->ref, sim, bc == 0, err));
+                          "cfl must be in (0, 1.5], got %g", o->cfl);
+  SPH_TRY(sph_node_get_bool(opt, "angular_momentum_projection", 0, 1, &o->amp,
+                            err));
+  SPH_TRY(sph_node_get_bool(opt, "jst_projection", 0, 1, &o->jproj, err));
+  return jst_options_parse(opt, o, err);
+}
+
+/* The per-slot arrays of the chosen force and dissipation: eq. 31's
+ * gradients of W~1 and reverse slots, the Laplacian weights
+ * V_b Lap W~_b(X_a) of the JST term (corrected, or the Brookshaw form with
+ * the corrected gradient of BENCHMARKS D.4). */
+static sph_status setup_slots(tl_jst *m, sph_sim *sim, const sph_cloud *cloud,
+                              int gradient_laplacian, int need_lap,
+                              sph_error *err) {
   size_t ne = m->ref.n_ext;
-  /* symmetry planes exert forces: the totals the projections zero are not
-   * zero there */
-  if (m->ref.n_img > n && (amp || jproj))
-    return sph_node_error(
-        sph_node_child(opt,
-                       amp ? "angular_momentum_projection" : "jst_projection"),
-        err, SPH_ERR_ARG,
-        "the momentum projections assume a free body; with symmetry planes "
-        "set angular_momentum_projection and jst_projection to false");
-  m->x = m->ref.x;
-  m->p = m->ref.p;
-  m->F = m->ref.F;
-  m->J = m->ref.J;
-  m->P = m->ref.P;
-  if (m->fields == TL_JST_PFHJ) {
-    SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->H, err));
-    for (size_t a = 0; a < ne; ++a)
-      sph_mat3_cofactor(m->F + 9 * a, m->H + 9 * a);
-  }
-  /* over MPI ranks the ghosts' rows are not used (nor complete) */
-  sph_cloud cloud = {.n = m->ref.n_img,
-                     .partial = m->ref.partial,
-                     .dim = s->dimension,
-                     .x = m->ref.X,
-                     .volume = m->ref.V,
-                     .nl = m->ref.nl,
-                     .kernel = &sim->kernel};
-  m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
-             : m->force == TL_JST_EQ31       ? sweep_eq31
-                                             : sweep_symmetric;
   if (m->force == TL_JST_EQ31) {
     SPH_TRY(alloc_zero(&m->fgrad, 3 * m->ref.nl->count, err));
     SPH_TRY(alloc_zero(&m->fgrad_self, 3 * ne, err));
-    SPH_TRY(sph_correction_gradient(&cloud, SPH_GRAD_W1, m->fgrad,
-                                    m->fgrad_self, NULL, err));
-    SPH_TRY(tl_reference_reverse_slots(&m->ref, &m->rev, err));
-    SPH_TRY(tl_ghost_slots(sim, &m->ref, &cloud, SPH_GRAD_W1, m->rev, m->fgrad,
-                           NULL, err));
+    SPH_TRY(sph_correction_gradient(cloud, SPH_GRAD_W1, m->fgrad, m->fgrad_self,
+                                    NULL, err));
+    SPH_TRY(sph_ref_reverse_slots(&m->ref, &m->rev, err));
+    SPH_TRY(sph_ref_ghost_slots(sim, &m->ref, cloud, SPH_GRAD_W1, m->rev,
+                                m->fgrad, NULL, err));
   }
-  int need_p = e2p != 0.0 || e4p != 0.0, need_j = e2j != 0.0 || e4j != 0.0;
-  if (need_p || need_j) {
-    SPH_TRY(alloc_zero(&m->lap, m->ref.nl->count, err));
-    if (lp == 0) {
-      SPH_TRY(sph_correction_laplacian(&cloud, m->lap, err));
-    } else {
-      /* Brookshaw form with the corrected gradient (BENCHMARKS D.4) */
-      const double *X = m->ref.X;
-      for (size_t a = 0; a < cloud.n; ++a)
-        for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1];
-             ++k) {
-          size_t b = (size_t)m->ref.nl->index[k];
-          double r[3], g[3];
-          tl_iact_pair_vector(X, a, b, r);
-          tl_reference_gradient(&m->ref, a, k, g);
-          m->lap[k] = -2.0 * sph_vec3_dot(r, g) / sph_vec3_dot(r, r);
-        }
-    }
-    /* the JST term takes V_b Lap W~_b(X_a) */
-    for (size_t a = 0; a < cloud.n; ++a)
-      for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k)
-        m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
+  if (!need_lap)
+    return SPH_OK;
+  SPH_TRY(alloc_zero(&m->lap, m->ref.nl->count, err));
+  if (!gradient_laplacian) {
+    SPH_TRY(sph_correction_laplacian(cloud, m->lap, err));
+  } else {
+    const double *X = m->ref.X;
+    for (size_t a = 0; a < cloud->n; ++a)
+      for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k) {
+        size_t b = (size_t)m->ref.nl->index[k];
+        double r[3], g[3];
+        ref_iact_pair_vector(X, a, b, r);
+        sph_ref_gradient(&m->ref, a, k, g);
+        m->lap[k] = -2.0 * sph_vec3_dot(r, g) / sph_vec3_dot(r, r);
+      }
   }
-  m->timer_force = sph_sim_add_timer(sim, "internal_force");
-  m->timer_integration = sph_sim_add_timer(sim, "time_integration");
+  /* the JST term takes V_b Lap W~_b(X_a) */
+  for (size_t a = 0; a < cloud->n; ++a)
+    for (size_t k = m->ref.nl->offset[a]; k < m->ref.nl->offset[a + 1]; ++k)
+      m->lap[k] *= m->ref.V[m->ref.nl->index[k]];
+  return SPH_OK;
+}
 
-  /* integrator storage */
+/* The integrator's copies and rates of the variables of the chosen
+ * fields. */
+static sph_status setup_ode(tl_jst *m, size_t n, sph_error *err) {
   size_t len[5] = {3 * n, 3 * n, 9 * n, 9 * n, n};
   double **y[5] = {&m->x, &m->p, &m->F, &m->H, &m->J};
   double **y0[5] = {&m->x0, &m->p0, &m->F0, &m->H0, &m->J0};
@@ -452,50 +441,111 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   ode->rhs = tl_jst_rhs;
   ode->constrain = tl_jst_constrain;
   ode->ctx = m;
+  return SPH_OK;
+}
 
-  /* terms, only those asked for, in the order of Algorithm 1 */
-  if (amp)
+/* The terms, only those asked for, in the order of Algorithm 1; the
+ * essential boundary conditions imposed on the initial state. */
+static sph_status setup_terms(tl_jst *m, sph_sim *sim, const sph_cloud *cloud,
+                              const tl_jst_options *o, sph_error *err) {
+  const sph_scene *s = sim->scene;
+  if (o->amp)
     SPH_TRY(angular_momentum_projection_create(sim, err));
-  if (need_p) {
+  if (o->e2p != 0.0 || o->e4p != 0.0) {
     if (m->force == TL_JST_CONSERVATIVE)
-      SPH_TRY(alloc_zero(&m->lu_p, 3 * ne, err));
+      SPH_TRY(alloc_zero(&m->lu_p, 3 * m->ref.n_ext, err));
     jst_params jp = {.nl = m->ref.nl,
                      .lap = m->lap,
                      .lu = m->lu_p,
                      .V = m->ref.V,
                      .ncomp = 3,
-                     .eps2 = e2p,
-                     .eps4 = e4p,
+                     .eps2 = o->e2p,
+                     .eps4 = o->e4p,
                      .cp = m->ref.cp,
                      .h = sim->dp,
-                     .project = jproj};
+                     .project = o->jproj};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  if (need_j) {
+  if (o->e2j != 0.0 || o->e4j != 0.0) {
     jst_params jp = {.nl = m->ref.nl,
                      .lap = m->lap,
                      .V = m->ref.V,
                      .ncomp = 1,
-                     .eps2 = e2j,
-                     .eps4 = e4j,
+                     .eps2 = o->e2j,
+                     .eps4 = o->e4j,
                      .cp = m->ref.cp,
                      .h = sim->dp,
-                     .project = jproj,
+                     .project = o->jproj,
                      .exchange_u = !m->ref.sync_images};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }
-  SPH_TRY(tl_external_terms_create(sim, &m->ref, err));
+  SPH_TRY(sph_step_external_terms(sim, &m->ref, err));
   int planes = 0;
   for (size_t k = 0; k < s->nboundaries; ++k)
     planes |= s->boundaries[k].kind == SPH_BC_SYMMETRY ||
               s->boundaries[k].kind == SPH_BC_SKEW_SYMMETRY;
-  if (bc == 1 && (planes || sph_scene_has_essential_bc(s))) {
+  if (o->lagrange && (planes || sph_scene_has_essential_bc(s))) {
     /* symmetry planes are constraints here, not mirror images */
-    SPH_TRY(lagrange_projection_create(sim, &cloud, m->ref.rho0,
-                                       lagrange_momentum, err));
+    SPH_TRY(lagrange_projection_create(sim, cloud, m->ref.rho0,
+                                       o->lagrange_momentum, err));
     return tl_jst_constrain(m, 0.0, err);
   }
-  return tl_essential_bc_attach(sim, &m->ref, tl_jst_constrain, m, err);
+  return sph_step_essential_bc(sim, &m->ref, tl_jst_constrain, m, err);
+}
+
+static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  tl_jst_options o = {0};
+  SPH_TRY(tl_jst_options_parse(opt, &o, err));
+  tl_jst *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "tl-jst");
+  sim->method_data = m;
+  m->sim = sim;
+  size_t n = sim->ps->n;
+  m->current_wave_speed = o.current_wave_speed;
+  m->integrate = o.integrate;
+  m->fields = o.fields;
+  m->force = o.force;
+  m->cfl = o.cfl;
+  /* reference configuration (with mirror images) and the state */
+  SPH_TRY(sph_ref_create(&m->ref, sim, !o.lagrange, err));
+  size_t ne = m->ref.n_ext;
+  /* symmetry planes exert forces: the totals the projections zero are not
+   * zero there */
+  if (m->ref.n_img > n && (o.amp || o.jproj))
+    return sph_node_error(
+        sph_node_child(opt, o.amp ? "angular_momentum_projection"
+                                  : "jst_projection"),
+        err, SPH_ERR_ARG,
+        "the momentum projections assume a free body; with symmetry planes "
+        "set angular_momentum_projection and jst_projection to false");
+  m->x = m->ref.x;
+  m->p = m->ref.p;
+  m->F = m->ref.F;
+  m->J = m->ref.J;
+  m->P = m->ref.P;
+  if (m->fields == TL_JST_PFHJ) {
+    SPH_TRY(sph_ref_alloc(&m->ref, 9, &m->H, err));
+    for (size_t a = 0; a < ne; ++a)
+      sph_mat3_cofactor(m->F + 9 * a, m->H + 9 * a);
+  }
+  /* over MPI ranks the ghosts' rows are not used (nor complete) */
+  sph_cloud cloud = {.n = m->ref.n_img,
+                     .partial = m->ref.partial,
+                     .dim = sim->scene->dimension,
+                     .x = m->ref.X,
+                     .volume = m->ref.V,
+                     .nl = m->ref.nl,
+                     .kernel = &sim->kernel};
+  m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
+             : m->force == TL_JST_EQ31       ? sweep_eq31
+                                             : sweep_symmetric;
+  int need_lap = o.e2p != 0.0 || o.e4p != 0.0 || o.e2j != 0.0 || o.e4j != 0.0;
+  SPH_TRY(setup_slots(m, sim, &cloud, o.gradient_laplacian, need_lap, err));
+  m->timer_force = sph_sim_add_timer(sim, "internal_force");
+  m->timer_integration = sph_sim_add_timer(sim, "time_integration");
+  SPH_TRY(setup_ode(m, n, err));
+  return setup_terms(m, sim, &cloud, &o, err);
 }
 
 static int tl_jst_state(sph_sim *sim, sph_state_array *out) {
@@ -517,7 +567,7 @@ const sph_method_ops tl_jst_method_ops = {
                  "eq. 11",
     .conserves_angular_momentum = 1,
     .distributed = 1,
-    .fields = TL_OUTPUT_FIELDS,
+    .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = tl_jst_setup,
     .stable_dt = tl_jst_stable_dt,
     .step = tl_jst_step,

@@ -1,7 +1,7 @@
 /* Pair interactions specific to tl-jst: the symmetric force of seed 003
  * eq. 11 (also eq. 30 of seed 000 with the uncorrected gradient) and the
  * kernel-gradient force of seed 000 eq. 31; the shared ones are in
- * methods/tl_iact.h. */
+ * methods/common/pair_iact.h. */
 #ifndef SPH_TL_JST_IACT_H
 #define SPH_TL_JST_IACT_H
 

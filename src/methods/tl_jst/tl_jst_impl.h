@@ -5,7 +5,7 @@
 #include <stddef.h>
 
 #include "integrators/integrator_impl.h"
-#include "methods/tl_common_impl.h"
+#include "methods/common/common_impl.h"
 
 typedef enum tl_jst_fields { TL_JST_PF, TL_JST_PFJ, TL_JST_PFHJ } tl_jst_fields;
 typedef enum tl_jst_force {
@@ -20,7 +20,7 @@ typedef struct tl_jst {
   tl_jst_force force;
   double cfl;
   int current_wave_speed; /* dt from the current state's c_p */
-  tl_reference ref;       /* neighbours, gradients, materials */
+  sph_ref ref;            /* neighbours, gradients, materials */
   double *lap;            /* V_b Lap W~_b(X_a) per slot (NULL if unused) */
   double *fgrad;          /* eq. 31: grad W~1_b(X_a) per slot */
   double *fgrad_self;     /* eq. 31: grad W~1_a(X_a) per particle */

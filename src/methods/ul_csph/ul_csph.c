@@ -24,7 +24,7 @@
  * mirrored, ghosts' from their owners, P, S = P F^r^T / J^r and the force
  * matrices for every point */
 static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   sph_domain *dom = m->sim->domain;
   long ne = (long)ref->n_ext;
@@ -34,15 +34,15 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
   /* an image's source may be a ghost: its state first */
   SPH_TRY(sph_domain_exchange(dom, m->x, 3, err));
   if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
-    tl_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
-    tl_pair_sums(ref, (size_t)a, m->x, 0, NULL, &s);
+    ref_sums s; /* f = grad_r x (seed 001 eq. 12-13) */
+    sph_ref_pair_sums(ref, (size_t)a, m->x, 0, NULL, &s);
     double f[9], unused[3];
-    tl_sums_store(&s, f, unused);
-    tl_iact_gradient_correct(f, ref->L + 9 * a);
-    tl_iact_plane_strain(f, dim);
+    ref_sums_store(&s, f, unused);
+    ref_iact_gradient_correct(f, ref->L + 9 * a);
+    ref_iact_plane_strain(f, dim);
     if (stab)
       memcpy(m->f0 + 9 * a, f, sizeof f);
     else
@@ -51,7 +51,7 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
   if (stab) {
     SPH_TRY(sph_domain_exchange(dom, m->f0, 9, err));
     if (ne > n)
-      tl_mirror_refresh(ref, m->x, m->p, m->f0, NULL, NULL);
+      sph_mirror_state(ref, m->x, m->p, m->f0, NULL, NULL);
 #pragma omp parallel for schedule(static)
     for (long a = 0; a < n; ++a) {
       double acc[9] = {0}, f[9];
@@ -63,13 +63,13 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
       }
       for (int c = 0; c < 9; ++c)
         f[c] = f0a[c] + m->eta * acc[c];
-      tl_iact_plane_strain(f, dim);
+      ref_iact_plane_strain(f, dim);
       ul_iact_total_defgrad(f, m->Fr + 9 * a, m->F + 9 * a);
     }
   }
   SPH_TRY(sph_domain_exchange(dom, m->F, 9, err));
   if (ne > n)
-    tl_mirror_refresh(ref, m->x, m->p, m->F, NULL, NULL);
+    sph_mirror_state(ref, m->x, m->p, m->F, NULL, NULL);
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < ne; ++a) {
     double H[9];
@@ -102,7 +102,7 @@ static sph_status deformation_and_stress(ul_csph *m, long n, sph_error *err) {
 /* the Hessian term's share of the force (adjoint of eq. 21's first
  * stabilisation term) */
 static void stabilisation_force(ul_csph *m, long n) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
@@ -124,7 +124,7 @@ static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
   long n = (long)sim->ps->n;
   double t0 = sph_wtime();
   SPH_TRY(deformation_and_stress(m, n, err));
-  tl_conservative_force(&m->ref, m->dp);
+  sph_ref_conservative_force(&m->ref, m->dp);
   if (m->eta > 0.0)
     stabilisation_force(m, n);
     /* per initial volume: dp_i = -T_i / V^0_i = J^r_i (-T_i / V^r_i) */
@@ -132,19 +132,19 @@ static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
   for (long a = 0; a < n; ++a)
     for (int c = 0; c < 3; ++c)
       m->dp[3 * a + c] *= m->Jr[a];
-  return tl_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
+  return sph_step_rates_terms(sim, &m->ref, m->dp, m->timer_force, t0, t, err);
 }
 
 static sph_status ul_csph_constrain(void *ctx, double t, sph_error *err) {
   ul_csph *m = ctx;
-  return tl_constrain_terms(m->sim, &m->ref, t, err);
+  return sph_step_constrain_terms(m->sim, &m->ref, t, err);
 }
 
 /* Per slot H~_k(x_a) h = H_k h + (A . (x_a - x_k)) h with the linear
  * correction A of eq. 19 contracted with h (the B of eq. 20 drops out of
  * the difference form), and g_k(x_a).h; per point their sums */
 static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   const sph_neighbors *nl = ref->nl;
   const sph_kernel *kernel = &m->sim->kernel;
   if (nl->count + 1 > m->slot_cap) { /* grows only, amortised */
@@ -163,7 +163,7 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
     m->slot_cap = cap;
   }
   SPH_TRY(sph_domain_agree(m->sim->domain,
-                           tl_reference_reverse_fill(ref, m->rev, err), err));
+                           sph_ref_reverse_fill(ref, m->rev, err), err));
   int dim = m->sim->scene->dimension;
   long ne = (long)ref->n_ext;
 #pragma omp parallel for schedule(static)
@@ -172,7 +172,7 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
     for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
       size_t b = (size_t)nl->index[k];
       double r[3], d;
-      tl_iact_pair_vector(ref->X, (size_t)a, b, r);
+      ref_iact_pair_vector(ref->X, (size_t)a, b, r);
       d = sqrt(sph_vec3_dot(r, r));
       double *hv = m->hv + 3 * k;
       if (d > 0.0)
@@ -223,9 +223,9 @@ static sph_status stabilisation_setup(ul_csph *m, sph_error *err) {
 /* over MPI ranks the particles migrate and the ghosts are found again; then
  * V^r = J^r V^0 (Remark 1) and the neighbours and corrections in X = x^r */
 static sph_status rebuild(ul_csph *m, sph_error *err) {
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   ul_mirror_sync(m);
-  SPH_TRY(tl_reference_redistribute(ref, m->sim, err));
+  SPH_TRY(sph_ref_redistribute(ref, m->sim, err));
   SPH_TRY(ul_mirror_place(m, err));
   m->lf.n = ref->n;
   long ne = (long)ref->n_ext;
@@ -234,7 +234,7 @@ static sph_status rebuild(ul_csph *m, sph_error *err) {
     m->Jr[a] = sph_mat3_det(m->Fr + 9 * a);
     ref->V[a] = m->Jr[a] * m->V0[a];
   }
-  sph_status st = tl_reference_rebuild(ref, m->sim, err);
+  sph_status st = sph_ref_rebuild(ref, m->sim, err);
   if (st == SPH_OK && m->eta > 0.0)
     st = stabilisation_setup(m, err);
   /* every rank learns of a failure before the next exchange */
@@ -244,7 +244,7 @@ static sph_status rebuild(ul_csph *m, sph_error *err) {
 /* x^r = x^n and F^r = F^n (seed 001 sec. 3.1, Fig. 8), timed on its own */
 static sph_status reference_update(ul_csph *m, sph_error *err) {
   sph_sim *sim = m->sim;
-  tl_reference *ref = &m->ref;
+  sph_ref *ref = &m->ref;
   double t0 = sph_wtime();
   SPH_TRY(deformation_and_stress(m, (long)ref->n, err));
   memcpy(ref->X, m->x, 3 * ref->n_ext * sizeof *ref->X);
@@ -260,13 +260,13 @@ static sph_status reference_update(ul_csph *m, sph_error *err) {
 
 static double ul_csph_stable_dt(sph_sim *sim) {
   const ul_csph *m = sim->method_data;
-  return tl_stable_dt(&m->ref, sim, m->cfl, 1);
+  return sph_ref_stable_dt(&m->ref, sim, m->cfl, 1);
 }
 
 /* the displacement criterion: some particle has moved more than
  * update_distance spacings from its reference position */
 static int moved_beyond(ul_csph *m) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   long n = (long)ref->n;
   double lim = m->update_distance * m->sim->dp, d2max = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : d2max)
@@ -285,27 +285,27 @@ static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
   if (m->update_distance > 0.0 ? moved_beyond(m) : m->since >= m->update_every)
     SPH_TRY(reference_update(m, err));
   m->since += 1.0;
-  return tl_leapfrog_step(sim, &m->ref, &m->lf, m->timer_integration, dt, err);
+  return sph_step_leapfrog(sim, &m->ref, &m->lf, m->timer_integration, dt, err);
 }
 
 static sph_status ul_csph_derive(sph_sim *sim, sph_error *err) {
   ul_csph *m = sim->method_data;
   SPH_TRY(deformation_and_stress(m, (long)sim->ps->n, err));
-  return tl_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
+  return sph_step_leapfrog_derive(sim, &m->ref, &m->lf, m->dp, err);
 }
 
 static void ul_csph_energy(sph_sim *sim, double *kinetic, double *strain) {
   ul_csph *m = sim->method_data;
-  tl_reference initial = m->ref; /* energy per initial volume */
+  sph_ref initial = m->ref; /* energy per initial volume */
   initial.V = m->V0;
-  tl_energy(sim, &initial, NULL, NULL, kinetic, strain);
+  sph_ref_energy(sim, &initial, NULL, NULL, kinetic, strain);
 }
 
 static void ul_csph_destroy(sph_sim *sim) {
   ul_csph *m = sim->method_data;
   if (!m)
     return;
-  tl_reference_destroy(&m->ref);
+  sph_ref_destroy(&m->ref);
   free(m->V0);
   free(m->Fr);
   free(m->Jr);
@@ -326,17 +326,21 @@ static void ul_csph_destroy(sph_sim *sim) {
   sim->method_data = NULL;
 }
 
-static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+/* The options of the method block. */
+typedef struct ul_csph_options {
+  double cfl;
+  int update_every;       /* steps between reference updates */
+  double update_distance; /* or: the largest displacement, in spacings */
+  double eta;             /* Hessian-difference stabilisation (sec. 3.4) */
+} ul_csph_options;
+
+static sph_status ul_csph_options_parse(sph_node *opt, ul_csph_options *o,
+                                        sph_error *err) {
   static const char *const keys[] = {
       "name", "cfl", "integrator", "update_every", "update_distance",
       "eta",  NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
-  ul_csph *m = calloc(1, sizeof *m);
-  if (!m)
-    return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph");
-  sim->method_data = m;
-  m->sim = sim;
-  SPH_TRY(tl_leapfrog_options(opt, &m->cfl, err));
+  SPH_TRY(sph_step_leapfrog_options(opt, &o->cfl, err));
   int by_steps = sph_node_child(opt, "update_every") != NULL;
   long every;
   SPH_TRY(sph_node_get_int(opt, "update_every", 0, 1, &every, err));
@@ -346,23 +350,38 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                           "update_every must be a number of steps >= 1, got "
                           "%ld",
                           every);
-  m->update_every = (int)every;
+  o->update_every = (int)every;
   SPH_TRY(sph_node_get_double(opt, "update_distance", 0, 0.0,
-                              &m->update_distance, err));
-  if (!(m->update_distance >= 0.0 && m->update_distance <= 1e6))
+                              &o->update_distance, err));
+  if (!(o->update_distance >= 0.0 && o->update_distance <= 1e6))
     return sph_node_error(
         sph_node_child(opt, "update_distance"), err, SPH_ERR_RANGE,
-        "update_distance must be >= 0 spacings, got %g", m->update_distance);
-  if (by_steps && m->update_distance > 0.0)
+        "update_distance must be >= 0 spacings, got %g", o->update_distance);
+  if (by_steps && o->update_distance > 0.0)
     return sph_node_error(sph_node_child(opt, "update_distance"), err,
                           SPH_ERR_RANGE,
                           "give update_every or update_distance, not both");
-  SPH_TRY(sph_node_get_double(opt, "eta", 0, 0.3, &m->eta, err));
-  if (!(m->eta >= 0.0 && m->eta <= 100.0))
+  SPH_TRY(sph_node_get_double(opt, "eta", 0, 0.3, &o->eta, err));
+  if (!(o->eta >= 0.0 && o->eta <= 100.0))
     return sph_node_error(sph_node_child(opt, "eta"), err, SPH_ERR_RANGE,
-                          "eta must be in [0, 100], got %g", m->eta);
+                          "eta must be in [0, 100], got %g", o->eta);
+  return SPH_OK;
+}
+
+static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
+  ul_csph_options o = {0};
+  SPH_TRY(ul_csph_options_parse(opt, &o, err));
+  ul_csph *m = calloc(1, sizeof *m);
+  if (!m)
+    return sph_error_set(err, SPH_ERR_NOMEM, "ul-csph");
+  sim->method_data = m;
+  m->sim = sim;
+  m->cfl = o.cfl;
+  m->update_every = o.update_every;
+  m->update_distance = o.update_distance;
+  m->eta = o.eta;
   const sph_scene *s = sim->scene;
-  SPH_TRY(tl_reference_create(&m->ref, sim, 1, err));
+  SPH_TRY(sph_ref_create(&m->ref, sim, 1, err));
   size_t ne = m->ref.n_ext;
   m->x = m->ref.x;
   m->p = m->ref.p;
@@ -370,13 +389,13 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->P = m->ref.P;
   m->dp = calloc(3 * m->ref.cap + 3, sizeof *m->dp);
   m->V0 = malloc((m->ref.cap + 1) * sizeof *m->V0);
-  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->Fr, err));
-  SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->Jr, err));
-  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->S, err));
-  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->f0, err));
-  SPH_TRY(tl_reference_alloc(&m->ref, 3, &m->sv, err));
-  SPH_TRY(tl_reference_alloc(&m->ref, 1, &m->sgh, err));
-  SPH_TRY(tl_reference_alloc(&m->ref, 9, &m->A, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 9, &m->Fr, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 1, &m->Jr, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 9, &m->S, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 9, &m->f0, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 3, &m->sv, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 1, &m->sgh, err));
+  SPH_TRY(sph_ref_alloc(&m->ref, 9, &m->A, err));
   /* h of Remark 2: the smoothing length along each axis of the body */
   for (int c = 0; c < s->dimension; ++c)
     m->h[c] = sim->kernel.h;
@@ -396,8 +415,8 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_domain_track(sim->domain, m->V0, 1, err));
   SPH_TRY(ul_mirror_setup(m, err));
   SPH_TRY(rebuild(m, err));
-  return tl_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,
-                            ul_csph_constrain, m, err);
+  return sph_step_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,
+                                  ul_csph_constrain, m, err);
 }
 
 static int ul_csph_state(sph_sim *sim, sph_state_array *out) {
@@ -425,7 +444,7 @@ static sph_status ul_csph_restore(sph_sim *sim, sph_error *err) {
   sim->timers[m->timer_update].calls++;
   if (st != SPH_OK)
     return st;
-  return tl_leapfrog_restore(sim, &m->lf, err);
+  return sph_step_leapfrog_restore(sim, &m->lf, err);
 }
 
 const sph_method_ops ul_csph_method_ops = {
@@ -434,7 +453,7 @@ const sph_method_ops ul_csph_method_ops = {
     .reference = "seed 001 (Vidal, Bonet, Huerta 2007) sec. 3-4, eq. 12-21",
     .conserves_angular_momentum = 1,
     .distributed = SPH_DISTRIBUTED_DYNAMIC,
-    .fields = TL_OUTPUT_FIELDS,
+    .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = ul_csph_setup,
     .stable_dt = ul_csph_stable_dt,
     .step = ul_csph_step,

@@ -1,6 +1,6 @@
-/* Pair interactions of ul-csph: the shared ones of methods/tl_iact.h taken
- * in the reference configuration x^r (ref->X after an update), summed by
- * tl_pair_sums: the incremental gradient f_a = sum_b (x_b - x_a) (x)
+/* Pair interactions of ul-csph: the shared ones of methods/common/pair_iact.h
+ * taken in the reference configuration x^r (ref->X after an update), summed by
+ * sph_ref_pair_sums: the incremental gradient f_a = sum_b (x_b - x_a) (x)
  * g_b(x^r_a) (seed 001 eq. 12-13 in the difference form of eq. 8) and the
  * Galerkin force of eq. 14 in the conservative pair form of seed 000
  * eq. 29c, with the stress P F^r^T / J^r per reference volume; the per
@@ -10,7 +10,7 @@
 #ifndef SPH_UL_CSPH_IACT_H
 #define SPH_UL_CSPH_IACT_H
 
-#include "methods/tl_iact.h"
+#include "methods/common/pair_iact.h"
 
 /* F = f F^r (seed 001 sec. 3.1) */
 static inline void ul_iact_total_defgrad(const double f[9], const double Fr[9],

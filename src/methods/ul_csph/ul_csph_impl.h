@@ -3,7 +3,7 @@
 #define SPH_UL_CSPH_IMPL_H
 
 #include "integrators/integrator_impl.h"
-#include "methods/tl_common_impl.h"
+#include "methods/common/common_impl.h"
 
 /* an image a rank places: its serial number, source point and slot */
 typedef struct ul_placed {
@@ -13,7 +13,7 @@ typedef struct ul_placed {
 } ul_placed;
 
 typedef struct ul_csph {
-  tl_reference ref; /* X, V, nl, L, w of the current reference x^r */
+  sph_ref ref; /* X, V, nl, L, w of the current reference x^r */
   double cfl;
   int update_every;       /* steps between reference updates */
   double update_distance; /* or when a particle has moved this many dp */
@@ -42,7 +42,7 @@ typedef struct ul_csph {
   ul_placed *placed;
 } ul_csph;
 
-/* ul_csph_mirror.c: nothing without tl_images. Set-up (the owned
+/* ul_csph_mirror.c: nothing without sph_mirror_table. Set-up (the owned
  * particles' images, tracked by the domain); after x^r = x, the owned
  * particles' images' reference positions kept; before a rebuild, x, p, F
  * into the particle set that migrates; after it, the ghosts moved behind

@@ -1,6 +1,6 @@
 /* ul-csph over MPI ranks with symmetry and skew-symmetry planes (issue 20):
- * the serial run's mirror images are fixed at set-up (tl_images, seed 000
- * sec. 8.2 / BENCHMARKS.md D.1), each carried by its source particle (its
+ * the serial run's mirror images are fixed at set-up (sph_mirror_table, seed
+ * 000 sec. 8.2 / BENCHMARKS.md D.1), each carried by its source particle (its
  * serial number and reference position move with it), and at every rebuild
  * a rank places, between its owned particles and its ghosts, the images of
  * its owned particles and those within three supports of its owned box
@@ -44,7 +44,7 @@ static int cmp_index(const void *pa, const void *pb) {
 }
 
 sph_status ul_mirror_setup(ul_csph *m, sph_error *err) {
-  const tl_images *t = m->ref.all_images;
+  const sph_mirror_table *t = m->ref.all_images;
   sph_sim *sim = m->sim;
   if (!t)
     return SPH_OK;
@@ -81,7 +81,7 @@ sph_status ul_mirror_setup(ul_csph *m, sph_error *err) {
 }
 
 void ul_mirror_store(ul_csph *m) {
-  const tl_reference *ref = &m->ref;
+  const sph_ref *ref = &m->ref;
   size_t K = (size_t)m->kimg;
   if (!ref->all_images)
     return;
@@ -111,8 +111,8 @@ static void shift(void *base, size_t w, size_t n, size_t c, size_t ng) {
 }
 
 sph_status ul_mirror_place(ul_csph *m, sph_error *err) {
-  tl_reference *ref = &m->ref;
-  const tl_images *t = ref->all_images;
+  sph_ref *ref = &m->ref;
+  const sph_mirror_table *t = ref->all_images;
   if (!t)
     return SPH_OK;
   sph_sim *sim = m->sim;
@@ -178,11 +178,7 @@ sph_status ul_mirror_place(ul_csph *m, sph_error *err) {
     if (ref->axes)
       ref->axes[g] = NULL;
     ref->src[g] = (int32_t)s;
-    memcpy(ref->vsign + 3 * g, t->vsign + 3 * j, 3);
-    memcpy(ref->rsign + 3 * g, t->rsign + 3 * j, 3);
-    ref->ssign[g] = t->ssign[j];
-    if (t->vmat)
-      memcpy(ref->vmat + 9 * g, t->vmat + 9 * j, 9 * sizeof *ref->vmat);
+    sph_images_assign(ref, g, t, j);
     m->gj[g] = q->j;
     ref->key[g] = (int64_t)t->n_real + q->j;
   }
@@ -190,13 +186,8 @@ sph_status ul_mirror_place(ul_csph *m, sph_error *err) {
   ref->n_ext = nr + c;
   ref->n_whole = n + whole;
   sph_domain_set_ghost_base(sim->domain, n + c);
-  ref->mirror = (sph_mirror){.n_real = n,
-                             .n_ghost = c,
-                             .src = ref->src + n,
-                             .vsign = ref->vsign + 3 * n,
-                             .vmat = t->vmat ? ref->vmat + 9 * n : NULL,
-                             .ssign = ref->ssign + n};
+  sph_images_publish(ref, t->vmat != NULL);
   /* F^r of the images (F^r = F of their sources at the update) */
-  tl_mirror_refresh(ref, m->x, m->p, m->Fr, NULL, NULL);
+  sph_mirror_state(ref, m->x, m->p, m->Fr, NULL, NULL);
   return SPH_OK;
 }

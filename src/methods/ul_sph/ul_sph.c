@@ -587,12 +587,42 @@ static sph_status check_scene(const sph_scene *s, sph_error *err) {
   return SPH_OK;
 }
 
+/* The per-particle arrays (room for the domain's capacity), those that move
+ * with a particle over MPI ranks tracked. */
+static sph_status setup_arrays(ul_sph *m, sph_sim *sim, size_t cap,
+                               double **rho0, double **c0, double **G,
+                               sph_error *err) {
+  SPH_TRY(alloc(&m->drho, cap, err));
+  SPH_TRY(alloc(&m->p, cap, err));
+  SPH_TRY(alloc(&m->m, cap, err));
+  SPH_TRY(alloc(rho0, cap, err));
+  m->rho0 = *rho0;
+  SPH_TRY(alloc(c0, cap, err));
+  m->c0 = *c0;
+  SPH_TRY(alloc(G, cap, err));
+  m->G = *G;
+  SPH_TRY(alloc(&m->acc, 6 * cap, err));
+  SPH_TRY(alloc(&m->work, cap, err));
+  SPH_TRY(alloc(&m->vol, cap, err));
+  SPH_TRY(alloc(&m->xcfg, 3 * cap, err));
+  if (m->shear == UL_SHEAR_LAPLACIAN)
+    SPH_TRY(alloc(&m->acc_shear, 3 * cap, err));
+  if (m->stress)
+    SPH_TRY(alloc(&m->sigma, 9 * cap, err));
+  if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
+    SPH_TRY(alloc(&m->R, 9 * cap, err));
+  /* over MPI ranks: what moves with a particle besides the set's fields */
+  double *moving[] = {m->drho, m->p, m->m, *rho0, *c0, *G, m->work};
+  for (size_t i = 0; i < sizeof moving / sizeof *moving; ++i)
+    SPH_TRY(sph_domain_track(sim->domain, moving[i], 1, err));
+  if (m->acc_shear)
+    SPH_TRY(sph_domain_track(sim->domain, m->acc_shear, 3, err));
+  if (m->sigma)
+    SPH_TRY(sph_domain_track(sim->domain, m->sigma, 9, err));
+  return SPH_OK;
+}
+
 static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
-  static const char *const keys[] = {
-      "name",          "shear",      "time_stepping", "cfl",
-      "cfl_advection", "continuity", "zeta",          "artificial_stress",
-      "dissipation",   NULL};
-  SPH_TRY(sph_node_check_keys(opt, keys, err));
   const sph_scene *s = sim->scene;
   SPH_TRY(check_scene(s, err));
   /* the stress is a rate-integrated state that starts at zero */
@@ -600,6 +630,8 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
     return sph_node_error(s->reference, err, SPH_ERR_ARG,
                           "ul-sph cannot start from the deformed state of a "
                           "`reference:` (its stress starts at zero)");
+  ul_sph_options o = {0};
+  SPH_TRY(ul_sph_options_parse(opt, s->dimension, &o, err));
   ul_sph *m = calloc(1, sizeof *m);
   if (!m)
     return sph_error_set(err, SPH_ERR_NOMEM, "ul-sph");
@@ -608,66 +640,15 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   sph_particles *ps = sim->ps;
   size_t n = m->n = ps->n;
   size_t cap = m->cap = sph_domain_capacity(sim->domain, ps);
-
-  /* options */
-  static const char *const shears[] = {"original", "artificial-stress",
-                                       "laplacian", NULL};
-  static const char *const stepping[] = {"dual", "single", NULL};
-  static const char *const cont[] = {"average", "riemann", NULL};
-  static const char *const diss[] = {"limited", "full", NULL};
-  int sh, ts, ct, ds;
-  SPH_TRY(sph_node_get_choice(opt, "shear", shears, "laplacian", &sh, err));
-  /* OG and OAS as the paper ran them: single-criterion (with dual steps
-   * OAS blows up on the rings within 1.5 ms) */
-  SPH_TRY(sph_node_get_choice(opt, "time_stepping", stepping,
-                              sh == UL_SHEAR_LAPLACIAN ? "dual" : "single", &ts,
-                              err));
-  SPH_TRY(sph_node_get_choice(opt, "continuity", cont, "average", &ct, err));
-  m->shear = (ul_shear)sh;
-  m->dual = ts == 0;
-  m->pressure_term = ct == 1;
-  /* full: the authors' code (SPHinXsys' dissipative Riemann solver for UL
-   * solids); limited: eq. 16 as printed, which lets ENOG's shear force
-   * (no potential) create energy after a rebound */
-  SPH_TRY(sph_node_get_choice(opt, "dissipation", diss, "full", &ds, err));
-  m->limited = ds == 0;
-  SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.4, &m->cfl_ac, err));
-  if (!(m->cfl_ac > 0.0 && m->cfl_ac <= 1.0))
-    return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
-                          "cfl must be in (0, 1], got %g", m->cfl_ac);
-  SPH_TRY(sph_node_get_double(opt, "cfl_advection", 0, 0.2, &m->cfl_ad, err));
-  if (!(m->cfl_ad > 0.0 && m->cfl_ad <= 1.0))
-    return sph_node_error(sph_node_child(opt, "cfl_advection"), err,
-                          SPH_ERR_RANGE,
-                          "cfl_advection must be in (0, 1], "
-                          "got %g",
-                          m->cfl_ad);
-  if (sph_node_child(opt, "zeta") && m->shear != UL_SHEAR_LAPLACIAN)
-    return sph_node_error(sph_node_child(opt, "zeta"), err, SPH_ERR_ARG,
-                          "zeta belongs to shear: laplacian");
-  if (m->shear == UL_SHEAR_LAPLACIAN) {
-    SPH_TRY(sph_node_get_double(opt, "zeta", 0, 0.7 * s->dimension + 2.1,
-                                &m->zeta, err));
-    if (!(m->zeta > 0.0))
-      return sph_node_error(sph_node_child(opt, "zeta"), err, SPH_ERR_RANGE,
-                            "zeta must be positive, got %g", m->zeta);
-  }
-  sph_node *as = sph_node_child(opt, "artificial_stress");
-  if (as && m->shear != UL_SHEAR_ARTIFICIAL_STRESS)
-    return sph_node_error(as, err, SPH_ERR_ARG,
-                          "artificial_stress belongs to shear: "
-                          "artificial-stress");
-  m->as_eps = 0.3;
-  m->as_n = 4.0;
-  if (as) {
-    static const char *const ak[] = {"epsilon", "n", NULL};
-    SPH_TRY(sph_node_check_keys(as, ak, err));
-    SPH_TRY(sph_node_get_double(as, "epsilon", 0, 0.3, &m->as_eps, err));
-    SPH_TRY(sph_node_get_double(as, "n", 0, 4.0, &m->as_n, err));
-    if (!(m->as_eps >= 0.0 && m->as_n > 0.0))
-      return sph_node_error(as, err, SPH_ERR_RANGE,
-                            "artificial_stress needs epsilon >= 0, n > 0");
-  }
+  m->shear = o.shear;
+  m->dual = o.dual;
+  m->pressure_term = o.pressure_term;
+  m->limited = o.limited;
+  m->cfl_ac = o.cfl_ac;
+  m->cfl_ad = o.cfl_ad;
+  m->zeta = o.zeta;
+  m->as_eps = o.as_eps;
+  m->as_n = o.as_n;
   m->as_w0 = sph_kernel_eval(&sim->kernel, sim->dp);
 
   /* fields: the state, and the outputs asked for */
@@ -690,33 +671,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->v = ps->field[SPH_FIELD_VELOCITY];
   m->rho = ps->field[SPH_FIELD_DENSITY];
   double *rho0, *c0, *G;
-  SPH_TRY(alloc(&m->drho, cap, err));
-  SPH_TRY(alloc(&m->p, cap, err));
-  SPH_TRY(alloc(&m->m, cap, err));
-  SPH_TRY(alloc(&rho0, cap, err));
-  m->rho0 = rho0;
-  SPH_TRY(alloc(&c0, cap, err));
-  m->c0 = c0;
-  SPH_TRY(alloc(&G, cap, err));
-  m->G = G;
-  SPH_TRY(alloc(&m->acc, 6 * cap, err));
-  SPH_TRY(alloc(&m->work, cap, err));
-  SPH_TRY(alloc(&m->vol, cap, err));
-  SPH_TRY(alloc(&m->xcfg, 3 * cap, err));
-  if (m->shear == UL_SHEAR_LAPLACIAN)
-    SPH_TRY(alloc(&m->acc_shear, 3 * cap, err));
-  if (m->stress)
-    SPH_TRY(alloc(&m->sigma, 9 * cap, err));
-  if (m->shear == UL_SHEAR_ARTIFICIAL_STRESS)
-    SPH_TRY(alloc(&m->R, 9 * cap, err));
-  /* over MPI ranks: what moves with a particle besides the set's fields */
-  double *moving[] = {m->drho, m->p, m->m, rho0, c0, G, m->work};
-  for (size_t i = 0; i < sizeof moving / sizeof *moving; ++i)
-    SPH_TRY(sph_domain_track(sim->domain, moving[i], 1, err));
-  if (m->acc_shear)
-    SPH_TRY(sph_domain_track(sim->domain, m->acc_shear, 3, err));
-  if (m->sigma)
-    SPH_TRY(sph_domain_track(sim->domain, m->sigma, 9, err));
+  SPH_TRY(setup_arrays(m, sim, cap, &rho0, &c0, &G, err));
   const double *X = ps->field[SPH_FIELD_POSITION0];
   const double *V0 = ps->field[SPH_FIELD_VOLUME0];
   for (size_t a = 0; a < n; ++a) {

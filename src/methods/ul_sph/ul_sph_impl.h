@@ -13,6 +13,22 @@ typedef enum ul_shear {
   UL_SHEAR_LAPLACIAN          /* SPH-ENOG: eq. 23-24 */
 } ul_shear;
 
+/* The options of the method block (ul_sph_options.c). */
+typedef struct ul_sph_options {
+  ul_shear shear;
+  int dual;          /* time_stepping: dual (else single) */
+  int pressure_term; /* continuity: riemann (else average) */
+  int limited;       /* dissipation: limited (else full) */
+  double cfl_ac, cfl_ad;
+  double zeta;         /* shear: laplacian */
+  double as_eps, as_n; /* shear: artificial-stress */
+} ul_sph_options;
+
+/* The method block's options into o (dim: the scene's dimension, of zeta's
+ * default). */
+sph_status ul_sph_options_parse(sph_node *opt, int dim, ul_sph_options *o,
+                                sph_error *err);
+
 struct ul_sph;
 
 /* the two pair loops of a run, chosen once at set-up */
