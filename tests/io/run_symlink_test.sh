@@ -29,6 +29,16 @@ planted() {
   n=$((n + 1))
   local out=$work/o$n target=$work/v$n
   mkdir -p "$out/$(dirname "$name")"
+  if [ "$name" = frames ]; then # a folder: nothing may appear in it
+    mkdir "$target"
+    ln -s "$target" "$out/$name"
+    "$sph" run "$scene" --out "$out" "${args[@]}" "$@" >"$work/log" 2>&1
+    local rc=$?
+    [ $rc -eq "$want" ] || fail "$name: exit $rc, expected $want: $(tail -2 "$work/log")"
+    grep -q "frames" "$work/log" || fail "$name: the message does not name it: $(tail -2 "$work/log")"
+    [ -z "$(ls "$target")" ] || fail "$name: written into the link's target: $(ls "$target" | head -3)"
+    return
+  fi
   printf 'precious %d\n' $n >"$target"
   cp "$target" "$work/keep"
   ln -s "$target" "$out/$name"
@@ -53,6 +63,7 @@ planted 3 scene_used.yaml.part
 planted 3 frames/twisting_column_0000.png
 planted 3 frames/twisting_column_0002.png.part
 planted 3 checkpoint.sphc
+planted 3 frames
 planted 3 checkpoint.sphc.part
 planted 3 checkpoint.prev.sphc
 
