@@ -13,6 +13,7 @@ packages=(
   libmatheval-dev   # expressions in scene files (velocity profiles)
   check             # unit test framework
   zlib1g-dev        # checkpoint checksums (CRC-32)
+  libexpat1-dev     # the XML of .pvd/.vtp/.pvtp files read back (sph render)
   libpng-dev        # PNG frames
   libosmesa6-dev    # off-screen OpenGL renderer
   libfreetype-dev fonts-dejavu-core  # text on frames

@@ -2,6 +2,7 @@
  * axis labelling), end triangles for clamped values, and the label block of
  * a frame; drawn with sph_text on an RGBA image. Edges of the triangles are
  * anti-aliased by 4 x 4 supersampling of their signed edge distances. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,8 +61,13 @@ int sph_colorbar_ticks(double min, double max, int max_ticks, double *ticks) {
   return 0;
 }
 
-/* floor(log10(v)) for v > 0, exact at powers of ten */
+/* floor(log10(v)) for v > 0, exact at powers of ten; a span that
+ * overflows (a range of -1e308 .. 1e308) counts as DBL_MAX's, and 0 or NaN
+ * as 1's (no int conversion of an infinity) */
 static int decade(double v) {
+  if (!(v > 0.0))
+    return 0;
+  v = fmin(v, DBL_MAX);
   int e = (int)floor(log10(v));
   if (pow(10.0, e + 1) <= v)
     e++;

@@ -147,6 +147,15 @@ sph_status sph_mp4_assemble(const char *dir, const char *scene, int frames,
   snprintf(part, sizeof part, "%s.part", info->path);
   snprintf(rate, sizeof rate, "%.6g", fps);
   snprintf(count, sizeof count, "%d", frames);
+  /* ffmpeg opens the .part by name: no link under either name (issue 36) */
+  struct stat ls;
+  const char *names[2] = {info->path, part};
+  for (int i = 0; i < 2; ++i)
+    if (lstat(names[i], &ls) == 0 && !S_ISREG(ls.st_mode))
+      return sph_error_at(err, SPH_ERR_IO, names[i], 0, 0, NULL,
+                          "not a regular file (a symbolic link?); sph does "
+                          "not write through links: remove it");
+  remove(part);
   int x264 = has_libx264(ffmpeg);
   snprintf(info->codec, sizeof info->codec, "%s", x264 ? "libx264" : "mpeg4");
   info->frames = frames;

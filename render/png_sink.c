@@ -674,6 +674,11 @@ static sph_status png_setup_buffers(png_sink *p, const sph_sim *sim,
   if (mkdir(p->dir, 0777) != 0 && errno != EEXIST)
     return sph_error_at(err, SPH_ERR_IO, p->dir, 0, 0, NULL,
                         "cannot create the frames folder: %s", strerror(errno));
+  struct stat ls; /* no frame written through a link (issue 36) */
+  if (lstat(p->dir, &ls) != 0 || !S_ISDIR(ls.st_mode))
+    return sph_error_at(err, SPH_ERR_IO, p->dir, 0, 0, NULL,
+                        "not a folder (a symbolic link?); sph does not write "
+                        "through links: remove it");
   /* over MPI ranks: room for the most particles a rank may hold */
   p->domain = sim->domain;
   p->rank = sph_domain_rank(sim->domain);

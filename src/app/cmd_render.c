@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "app/app_impl.h"
 #include "io/sink.h"
@@ -133,6 +134,10 @@ typedef struct render_job {
   sph_particles *ps;
   sph_pvd pvd;
   char dir[1024], out[1100];
+  /* a run over MPI ranks: particle k of the pieces is particle order[k]
+   * (NULL: the files' order is the particles') and room to place them */
+  size_t *order;
+  double *scratch;
 } render_job;
 
 static sph_status vtp_path(const render_job *j, int i, char *path, size_t n,
@@ -143,6 +148,85 @@ static sph_status vtp_path(const render_job *j, int i, char *path, size_t n,
   return SPH_OK;
 }
 
+static const double *sort_x;
+static int cmp_point(const void *pa, const void *pb) {
+  const double *a = sort_x + 3 * *(const size_t *)pa,
+               *b = sort_x + 3 * *(const size_t *)pb;
+  for (int c = 0; c < 3; ++c)
+    if (a[c] != b[c])
+      return a[c] < b[c] ? -1 : 1;
+  return 0;
+}
+
+/* positions sorted: idx of n points of x */
+static void sort_points(const double *x, size_t *idx, size_t n) {
+  for (size_t k = 0; k < n; ++k)
+    idx[k] = k;
+  sort_x = x;
+  qsort(idx, n, sizeof *idx, cmp_point);
+}
+
+/* A run over MPI ranks without particle_id lists each rank's particles in
+ * its pieces: frame 0's positions, the particles' initial ones, say which
+ * is which (the points sorted both ways must be equal, one by one, and
+ * distinct); otherwise the files' order is kept. */
+static sph_status piece_order(render_job *j, sph_error *err) {
+  size_t n = j->ps->n, len = strlen(j->pvd.file[0]);
+  if (n == 0 || len < 5 || strcmp(j->pvd.file[0] + len - 5, ".pvtp"))
+    return SPH_OK;
+  char path[1400];
+  double t;
+  SPH_TRY(vtp_path(j, 0, path, sizeof path, err));
+  double *x = malloc(3 * n * sizeof *x);
+  size_t *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+  j->order = malloc(n * sizeof *j->order);
+  j->scratch = malloc(3 * n * sizeof *j->scratch);
+  if (!x || !a || !b || !j->order || !j->scratch) {
+    free(x), free(a), free(b);
+    return sph_error_set(err, SPH_ERR_NOMEM, "reading %s", path);
+  }
+  sph_status st = sph_vtp_read(path, n, x, NULL, 1, NULL, &t, err);
+  const double *X = j->ps->field[SPH_FIELD_POSITION0];
+  int ok = st == SPH_OK && X, moved = 0;
+  if (ok) {
+    sort_points(x, a, n);
+    sort_points(X, b, n);
+  }
+  for (size_t k = 0; ok && k < n; ++k) {
+    ok = !memcmp(x + 3 * a[k], X + 3 * b[k], 3 * sizeof *x) &&
+         (k == 0 || memcmp(x + 3 * a[k], x + 3 * a[k - 1], 3 * sizeof *x));
+    j->order[a[k]] = b[k];
+    moved |= a[k] != b[k];
+  }
+  if (!ok || !moved) { /* the files' order */
+    free(j->order);
+    j->order = NULL;
+  }
+  free(x), free(a), free(b);
+  return st;
+}
+
+/* frame i's points and field `name` (nc components) in the particles'
+ * order */
+static sph_status read_frame(render_job *j, int i, const char *name, int nc,
+                             double *values, double *t, sph_error *err) {
+  char path[1400];
+  size_t n = j->ps->n;
+  double *x = j->ps->field[SPH_FIELD_POSITION];
+  SPH_TRY(vtp_path(j, i, path, sizeof path, err));
+  SPH_TRY(sph_vtp_read(path, n, x, name, nc, values, t, err));
+  if (!j->order)
+    return SPH_OK;
+  for (int pass = 0; pass < (name ? 2 : 1); ++pass) {
+    double *v = pass ? values : x;
+    size_t w = pass ? (size_t)nc : 3;
+    memcpy(j->scratch, v, w * n * sizeof *v);
+    for (size_t k = 0; k < n; ++k)
+      memcpy(v + w * j->order[k], j->scratch + w * k, w * sizeof *v);
+  }
+  return SPH_OK;
+}
+
 /* the range over every frame (centred like the map: pressure about 0, J
  * about 1) */
 static sph_status global_range(render_job *j, int field, sph_error *err) {
@@ -150,12 +234,9 @@ static sph_status global_range(render_job *j, int field, sph_error *err) {
   int nc = sph_field_components((sph_field)field);
   double c = nc == 1 ? sph_png_field_centre(field) : NAN;
   double lo = INFINITY, hi = -INFINITY, amax = 0.0, t;
-  char path[1400];
   for (int i = 0; i < j->pvd.count; ++i) {
-    SPH_TRY(vtp_path(j, i, path, sizeof path, err));
-    SPH_TRY(sph_vtp_read(path, ps->n, ps->field[SPH_FIELD_POSITION],
-                         sph_field_name((sph_field)field), nc, ps->field[field],
-                         &t, err));
+    SPH_TRY(read_frame(j, i, sph_field_name((sph_field)field), nc,
+                       ps->field[field], &t, err));
     for (size_t a = 0; a < ps->n; ++a) {
       double v = sph_png_value(ps->field[field], nc, a);
       if (!isfinite(v))
@@ -195,19 +276,14 @@ static sph_status render_frames(render_job *j, int *frames, sph_error *err) {
   SPH_TRY(sph_png_check(&sim, err));
   sph_sink sink = {.ops = &sph_png_sink_sync_ops};
   sph_status st = sink.ops->open(&sink, &sim, j->out, err);
-  char path[1400];
   for (int i = 0; st == SPH_OK && i < j->pvd.count; ++i) {
     double t;
-    st = vtp_path(j, i, path, sizeof path, err);
-    if (st == SPH_OK)
-      st = sph_vtp_read(path, ps->n, ps->field[SPH_FIELD_POSITION],
-                        sph_field_name((sph_field)field), nc, ps->field[field],
-                        &t, err);
+    st = read_frame(j, i, sph_field_name((sph_field)field), nc,
+                    ps->field[field], &t, err);
     /* J sizes the spheres as in the run (the sink's V0 J) */
     if (st == SPH_OK && ps->field[SPH_FIELD_JACOBIAN] &&
         field != SPH_FIELD_JACOBIAN)
-      st = sph_vtp_read(path, ps->n, ps->field[SPH_FIELD_POSITION], "J", 1,
-                        ps->field[SPH_FIELD_JACOBIAN], &t, err);
+      st = read_frame(j, i, "J", 1, ps->field[SPH_FIELD_JACOBIAN], &t, err);
     sph_frame fr = {.time = isfinite(t) ? t : j->pvd.time[i],
                     .index = i,
                     .sim = &sim,
@@ -225,6 +301,21 @@ static sph_status render_frames(render_job *j, int *frames, sph_error *err) {
   }
   sink.ops->destroy(&sink);
   return st;
+}
+
+/* after a failure: the frames written, and the folders when they are
+ * empty (the output folder only when this render made it) */
+static void remove_frames(const render_job *j, int frames, int made) {
+  char path[1400];
+  for (int i = 0; i < frames; ++i) {
+    snprintf(path, sizeof path, "%s/frames/%s_%04d.png", j->out, j->scene->name,
+             i);
+    remove(path);
+  }
+  snprintf(path, sizeof path, "%s/frames", j->out);
+  rmdir(path);
+  if (made)
+    rmdir(j->out);
 }
 
 static sph_status render_run(render_args *a, int *frames, sph_error *err) {
@@ -255,30 +346,35 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
     st = sph_particles_require(j.ps, SPH_FIELD_POSITION, err);
   if (st == SPH_OK)
     st = sph_particles_require(j.ps, (sph_field)field, err);
+  if (st == SPH_OK && j.pvd.count > 0)
+    st = piece_order(&j, err);
   /* the files' J, when they hold it, sizes the spheres as the run did */
   if (st == SPH_OK && j.pvd.count > 0) {
-    char path[1400];
     double t;
     sph_error jerr;
-    if (vtp_path(&j, 0, path, sizeof path, &jerr) == SPH_OK &&
-        sph_particles_require(j.ps, SPH_FIELD_JACOBIAN, &jerr) == SPH_OK &&
-        sph_vtp_read(path, j.ps->n, j.ps->field[SPH_FIELD_POSITION], "J", 1,
-                     j.ps->field[SPH_FIELD_JACOBIAN], &t, &jerr) != SPH_OK) {
+    if (sph_particles_require(j.ps, SPH_FIELD_JACOBIAN, &jerr) == SPH_OK &&
+        read_frame(&j, 0, "J", 1, j.ps->field[SPH_FIELD_JACOBIAN], &t, &jerr) !=
+            SPH_OK) {
       free(j.ps->field[SPH_FIELD_JACOBIAN]);
       j.ps->field[SPH_FIELD_JACOBIAN] = NULL;
     }
   }
   if (st == SPH_OK && a->range && !strcmp(a->range, "global"))
     st = global_range(&j, field, err);
+  struct stat before;
+  int made = 0; /* the output folder is ours: removed again on failure */
   if (st == SPH_OK) {
     if (a->out)
       snprintf(j.out, sizeof j.out, "%s", a->out);
     else
       snprintf(j.out, sizeof j.out, "%s/render", j.dir);
+    made = stat(j.out, &before) != 0;
     st = sph_run_output_dir(j.out, err);
   }
   if (st == SPH_OK)
     st = render_frames(&j, frames, err);
+  if (st != SPH_OK && j.out[0]) /* nothing left behind (issue 36) */
+    remove_frames(&j, *frames, made);
   if (st == SPH_OK &&
       (a->mp4 == 1 || (a->mp4 < 0 && j.scene->output.png.mp4))) {
     sph_mp4_info info = {0};
@@ -298,6 +394,8 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
   if (st == SPH_OK)
     printf("rendered %d frames of %s into %s/frames\n", *frames, pvd, j.out);
   sph_pvd_destroy(&j.pvd);
+  free(j.order);
+  free(j.scratch);
   sph_particles_destroy(j.ps);
   sph_scene_destroy(j.scene);
   return st;

@@ -14,6 +14,7 @@
 
 #include "app/app_impl.h"
 #include "app/study_impl.h"
+#include "io/sink.h"
 #include "scene/node.h"
 #include "scene/scene.h"
 #include "solver/sim.h"
@@ -333,7 +334,7 @@ static void run_case(const study *s, const study_args *a, const study_case *c,
   fflush(stderr);
   pid_t pid = fork();
   if (pid == 0) {
-    int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+    int fd = sph_open_nofollow(log, O_WRONLY | O_CREAT | O_TRUNC, 0666, NULL);
     if (fd >= 0) {
       dup2(fd, 1);
       dup2(fd, 2);
@@ -370,7 +371,7 @@ static int cmp_double(const void *a, const void *b) {
 
 /* Appends the row to results.csv and makes it durable. */
 static int append_row(const study *s, const study_case *c, const char *csv) {
-  FILE *f = fopen(csv, "a");
+  FILE *f = sph_fopen_nofollow(csv, "a", NULL); /* no link (issue 36) */
   if (!f)
     return -1;
   study_csv_row(s, c, f);
@@ -382,7 +383,7 @@ static int append_row(const study *s, const study_case *c, const char *csv) {
 static int start_csv(const study *s, const char *csv) {
   char tmp[1200];
   snprintf(tmp, sizeof tmp, "%s.part", csv);
-  FILE *f = fopen(tmp, "w");
+  FILE *f = sph_fopen_nofollow(tmp, "w", NULL); /* no link (issue 36) */
   if (!f)
     return -1;
   study_csv_header(s, f);

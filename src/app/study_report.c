@@ -2,6 +2,7 @@
  * report.md with the fitted convergence orders, and the gnuplot script that
  * draws error_vs_time.png and convergence.png. */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -626,9 +627,12 @@ sph_status study_plots_write(const study *s, sph_error *err) {
   fflush(stderr);
   pid_t pid = fork();
   if (pid == 0) {
-    FILE *l = freopen(log, "w", stdout);
-    if (l)
-      dup2(fileno(l), 2);
+    int l = sph_open_nofollow(log, O_WRONLY | O_CREAT | O_TRUNC, 0666, NULL);
+    if (l >= 0) { /* no link followed (issue 36) */
+      dup2(l, 1);
+      dup2(l, 2);
+      close(l);
+    }
     execl(gnuplot, "gnuplot", script, (char *)NULL);
     _exit(127);
   }

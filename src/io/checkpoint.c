@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include "io/checkpoint.h"
@@ -209,7 +210,15 @@ static sph_status write_file(const char *path, const char *prev,
   fwrite(&check, 4, 1, af.f);
   sum->size = w.bytes + 4;
   sum->crc = check;
-  /* keep the last good one until the new one is in place */
+  /* keep the last good one until the new one is in place (rename follows
+   * no link; one under the name is refused as every output's is) */
+  struct stat sb;
+  if (prev && lstat(prev, &sb) == 0 && S_ISLNK(sb.st_mode)) {
+    sph_atomic_abort(&af);
+    return sph_error_at(err, SPH_ERR_IO, prev, 0, 0, NULL,
+                        "is a symbolic link; sph does not write through "
+                        "links (remove it, or write elsewhere with --out)");
+  }
   if (prev && rename(path, prev) != 0 && errno != ENOENT) {
     sph_atomic_abort(&af);
     return sph_error_at(err, SPH_ERR_IO, prev, 0, 0, NULL,
@@ -250,9 +259,10 @@ typedef struct manifest {
 static sph_status manifest_read(const char *path, int rank, manifest *m,
                                 sph_error *err) {
   memset(m, 0, sizeof *m);
-  FILE *f = fopen(path, "r");
-  if (!f)
-    return sph_error_set(err, SPH_ERR_IO, "cannot open: %s", strerror(errno));
+  FILE *f;
+  sph_error oe;
+  if (sph_fopen_input(path, &f, NULL, &oe) != SPH_OK)
+    return sph_error_set(err, SPH_ERR_IO, "%s", oe.message);
   char line[256];
   uLong crc = crc32(0L, Z_NULL, 0);
   int sealed = 0, ok = 1, version = 0;
@@ -425,32 +435,46 @@ typedef struct loaded {
 /* Checks one file against the simulation (and, for a piece of a run over
  * MPI ranks, against its manifest m); on success copies the state arrays
  * in and the rest into *out (the verdict over a copy of v). */
+/* The most bytes a checkpoint of this simulation can hold: the header,
+ * verdict and call counts with room to spare, and the state arrays of the
+ * most particles this rank can own. */
+static size_t most_bytes(sph_sim *sim) {
+  sph_state_array arr[SPH_MAX_STATE + 3];
+  size_t n_run = sim->ps->n, most = sph_domain_capacity(sim->domain, sim->ps);
+  sim->ps->n = sph_domain_migrates(sim->domain) && most > n_run ? most : n_run;
+  int na = state_arrays(sim, sim->ps->n, 0, arr);
+  sim->ps->n = n_run;
+  size_t bytes = 4096 + sizeof(sph_verdict) +
+                 8 * (size_t)(SPH_MAX_TIMERS + SPH_MAX_TERMS) +
+                 24 * (size_t)(SPH_MAX_STATE + 3);
+  for (int i = 0; i < na; ++i)
+    bytes += arr[i].len * sizeof(double);
+  return bytes;
+}
+
+/* Checks one file against the simulation (and, for a piece of a run over
+ * MPI ranks, against its manifest m); on success copies the state arrays
+ * in and the rest into *out (the verdict over a copy of v). */
 static sph_status load(const char *path, const manifest *m, sph_sim *sim,
                        const sph_verdict *v, loaded *out, sph_error *err) {
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL, "cannot open: %s",
-                        strerror(errno));
-  unsigned char *buf = NULL;
-  size_t len = 0, cap = 0;
-  for (;;) {
-    if (len == cap) {
-      cap = cap ? 2 * cap : 1 << 20;
-      unsigned char *nb = realloc(buf, cap);
-      if (!nb) {
-        free(buf);
-        fclose(f);
-        return sph_error_set(err, SPH_ERR_NOMEM, "checkpoint");
-      }
-      buf = nb;
-    }
-    size_t got = fread(buf + len, 1, cap - len, f);
-    len += got;
-    if (got == 0)
-      break;
+  /* a regular file (a FIFO would hang); one larger than this simulation's
+   * checkpoint can be is not read whole: its header says why (another
+   * scene, method or particle count), else its size */
+  FILE *f;
+  long long size = 0;
+  SPH_TRY(sph_fopen_input(path, &f, &size, err));
+  size_t limit = most_bytes(sim);
+  int oversize = size < 0 || (unsigned long long)size > limit;
+  size_t len = oversize ? 4096 : (size_t)size;
+  unsigned char *buf = malloc(len ? len : 1);
+  if (!buf) {
+    fclose(f);
+    return sph_error_set(err, SPH_ERR_NOMEM, "checkpoint");
   }
-  int bad_read = ferror(f);
+  size_t got = fread(buf, 1, len, f);
+  int bad_read = (!oversize && got != len) || ferror(f);
   fclose(f);
+  len = got;
   sph_status st = SPH_OK;
 #define FAIL(...)                                                              \
   do {                                                                         \
@@ -458,19 +482,20 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
     goto done;                                                                 \
   } while (0)
   if (bad_read)
-    FAIL("cannot read");
+    FAIL("cannot read (it changed while read)");
   if (len < 12 || memcmp(buf, magic, sizeof magic))
     FAIL("not an sph checkpoint");
   uint32_t sum;
   memcpy(&sum, buf + len - 4, 4);
-  if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), buf, (uInt)(len - 4)) != sum)
+  if (!oversize &&
+      (uint32_t)crc32(crc32(0L, Z_NULL, 0), buf, (uInt)(len - 4)) != sum)
     FAIL("checksum mismatch: the file is damaged or truncated");
-  if (m && (len != m->mine.size || sum != m->mine.crc))
+  if (!oversize && m && (len != m->mine.size || sum != m->mine.crc))
     FAIL("not the piece its manifest names (%zu bytes, checksum %08lx; the "
          "manifest: %llu bytes, %08lx): left by another checkpoint",
          len, (unsigned long)sum, (unsigned long long)m->mine.size,
          (unsigned long)m->mine.crc);
-  reader r = {buf, len - 4, sizeof magic};
+  reader r = {buf, oversize ? len : len - 4, sizeof magic};
   uint32_t version = 0, tag = 0, na = 0;
   header h;
   memset(out, 0, sizeof *out);
@@ -507,6 +532,10 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
          "resolved settings differ; resume with the same scene and --set "
          "options)",
          h.scene);
+  if (oversize)
+    FAIL("%lld bytes, a checkpoint of this run holds at most %zu: damaged, "
+         "or not its checkpoint",
+         size, limit);
   if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1)
     FAIL("time %g or output index %d out of range", h.t, h.next_output);
   if (m && (h.t != m->t || h.steps != m->step))
@@ -642,17 +671,17 @@ static sph_status resume_distributed(const char *dir, sph_sim *sim,
   }
   char serial[1100];
   snprintf(serial, sizeof serial, "%s/%s", dir, SPH_CHECKPOINT_FILE);
-  FILE *f = fopen(serial, "rb");
-  if (f)
-    fclose(f);
+  struct stat sb;
+  int serial_there = stat(serial, &sb) == 0;
   return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
                       "no valid checkpoint of %d MPI ranks to resume from "
                       "(checkpoint_a.sphm: %s; checkpoint_b.sphm: %s)%s",
                       ranks, why[0], why[1],
-                      f ? "; the folder holds the checkpoint of a run "
-                          "without MPI (" SPH_CHECKPOINT_FILE
-                          "): resume it without mpirun"
-                        : "");
+                      serial_there
+                          ? "; the folder holds the checkpoint of a run "
+                            "without MPI (" SPH_CHECKPOINT_FILE
+                            "): resume it without mpirun"
+                          : "");
 }
 
 sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,

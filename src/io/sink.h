@@ -4,6 +4,7 @@
 #define SPH_SINK_H
 
 #include <stdio.h>
+#include <sys/types.h>
 
 #include "solver/sim.h"
 #include "sph/status.h"
@@ -89,5 +90,21 @@ sph_status sph_stream_row_end(sph_atomic_file *af, sph_error *err);
 sph_status sph_atomic_flush(sph_atomic_file *af, sph_error *err);
 /* Closes and removes the temporary file (safe after a failed commit). */
 void sph_atomic_abort(sph_atomic_file *af);
+
+/* Opening files without following links (issue 36; src/io/atomic_file.c).
+ * An output: open(2) flags and mode with O_NOFOLLOW added (O_TRUNC applied
+ * only once the file is known to be a regular file with one link; a FIFO
+ * never blocks). A link, a folder, FIFO or device, or a file with other
+ * hard links under the name is refused naming the file, SPH_ERR_IO as any
+ * other failure to write (SPH_ERR_ARG when opened read-only). Returns the
+ * descriptor or -1 with err filled and errno set. */
+int sph_open_nofollow(const char *path, int flags, mode_t mode, sph_error *err);
+/* The same as a FILE: mode "r", "w" or "a", with "+" and "x" (O_EXCL). */
+FILE *sph_fopen_nofollow(const char *path, const char *mode, sph_error *err);
+/* An input (a checkpoint, a .vtp): opened without blocking and refused
+ * with SPH_ERR_ARG unless a regular file (a FIFO would hang the read);
+ * *size receives its size when size is not NULL. */
+sph_status sph_fopen_input(const char *path, FILE **f, long long *size,
+                           sph_error *err);
 
 #endif

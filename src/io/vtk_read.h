@@ -1,7 +1,8 @@
 /* Reading back what the VTK sink writes (src/io/vtk_sink.c): the .pvd
- * collection's files and times, and a .vtp file's points and one Float64
- * point array, appended raw (UInt64 block headers) or ASCII. Only this
- * writer's layout is read; anything else is refused naming the file. */
+ * collection's files and times, and a .vtp file's (or a .pvtp's pieces')
+ * points and one Float64 point array, appended raw (UInt64 block headers),
+ * zlib-compressed or ASCII. Only this writer's layout is read (parsed with
+ * libexpat); anything else is refused naming the file and line. */
 #ifndef SPH_VTK_READ_H
 #define SPH_VTK_READ_H
 
@@ -24,7 +25,10 @@ void sph_pvd_destroy(sph_pvd *pvd);
 
 /* Reads n points (3 n doubles) and, when name is not NULL, the point array
  * `name` of ncomp components (n ncomp doubles) from a .vtp file, and its
- * TimeValue (NaN without one). A missing file is SPH_ERR_IO; a different
+ * TimeValue (NaN without one). A .pvtp (a run over MPI ranks) gives its
+ * pieces' points one after the other, placed by particle_id when every
+ * piece has it (else in rank order; sph render places them by the first
+ * frame's positions). A missing file is SPH_ERR_IO; a different
  * point count, a missing array (the message lists the file's arrays) or a
  * damaged file SPH_ERR_SYNTAX, naming the file. */
 sph_status sph_vtp_read(const char *path, size_t n, double *points,

@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <yaml.h>
 
 #include "scene/node.h"
@@ -264,6 +265,11 @@ sph_status sph_node_load_text(const char *text, size_t len, const char *origin,
 sph_status sph_node_load_file(sph_node **root, const char *path,
                               sph_error *err) {
   *root = NULL;
+  struct stat sb; /* a FIFO would hang the read (issue 36) */
+  if (stat(path, &sb) == 0 && !S_ISREG(sb.st_mode))
+    return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,
+                        "not a regular file (a folder, FIFO or device); a "
+                        "scene is a file");
   FILE *f = fopen(path, "rb");
   if (!f)
     return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL,

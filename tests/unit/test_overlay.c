@@ -171,6 +171,11 @@ START_TEST(bar_end_labels) {
   ck_assert_str_eq(l, "0.851");
   sph_colorbar_end_label(0.0, 0.0, 2.0, l);
   ck_assert_str_eq(l, "0");
+  /* a span that overflows (issue 36: a signed overflow under UBSan) */
+  sph_colorbar_end_label(1e308, -1e308, 1e308, l);
+  ck_assert_str_eq(l, "100e306");
+  sph_colorbar_end_label(-1e308, -1e308, 1e308, l);
+  ck_assert_str_eq(l, "-100e306");
 }
 END_TEST
 
