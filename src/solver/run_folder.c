@@ -85,7 +85,9 @@ static void remove_run_files(const char *dir, const char *scene) {
   char sub[2][1100];
   snprintf(sub[0], sizeof sub[0], "%s", dir);
   snprintf(sub[1], sizeof sub[1], "%s/frames", dir);
-  for (int k = 0; k < 2; ++k) {
+  struct stat fst; /* a frames folder that is a link is not ours */
+  int frames_linked = lstat(sub[1], &fst) == 0 && S_ISLNK(fst.st_mode);
+  for (int k = 0; k < 2 - frames_linked; ++k) {
     DIR *d = opendir(sub[k]);
     struct dirent *e;
     while (d && (e = readdir(d))) {
@@ -112,7 +114,9 @@ static void remove_run_files(const char *dir, const char *scene) {
 void sph_run_remove_previous(const char *dir, const char *scene) {
   char path[1200], line[256], previous[256] = "";
   snprintf(path, sizeof path, "%s/scene_used.yaml", dir);
-  FILE *f = fopen(path, "r");
+  FILE *f = NULL; /* never a FIFO or a link's target */
+  if (sph_fopen_input(path, &f, NULL, NULL) != SPH_OK)
+    f = NULL;
   while (f && fgets(line, sizeof line, f))
     if (!strncmp(line, "name: ", 6)) {
       line[strcspn(line, "\r\n")] = '\0';
@@ -156,7 +160,8 @@ static int lock_output(const char *dir, long *holder) {
   char path[1100];
   snprintf(path, sizeof path, "%s/.sph.lock", dir);
   *holder = 0;
-  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  /* a link or another hard link under the name is refused (issue 36) */
+  int fd = sph_open_nofollow(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644, NULL);
   if (fd < 0)
     return -1;
   if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
