@@ -25,3 +25,10 @@ def test_block_runs(index, monkeypatch, tmp_path, capsys):
 
 def test_page_has_a_study():
     assert BLOCKS, "docs/python.md has no python block"
+
+
+def test_readme_study_is_the_tested_one():
+    # the README shows the same study as docs/python.md (run above)
+    readme = (ROOT / "README.md").read_text()
+    shown = re.findall(r"^```python\n(.*?)^```", readme, re.S | re.M)
+    assert shown and shown[0] == BLOCKS[0]
