@@ -31,7 +31,8 @@
   X(SPH_ERR_GEOMETRY, "invalid geometry")                                      \
   X(SPH_ERR_SINGULAR, "singular moment matrix")                                \
   X(SPH_ERR_UNSUPPORTED, "not supported")                                      \
-  X(SPH_ERR_NUMERIC, "non-finite value")
+  X(SPH_ERR_NUMERIC, "non-finite value")                                       \
+  X(SPH_ERR_INTERNAL, "internal invariant violated")
 
 typedef enum sph_status {
 #define SPH_STATUS_ENUM(code, msg) code,

@@ -14,8 +14,8 @@
 #define SPH_EXIT_USAGE 2
 #define SPH_EXIT_IO 3
 
-/* The exit code of a library status: 3 for I/O and memory, 2 otherwise
- * (bad input); 0 for SPH_OK. */
+/* The exit code of a library status: 3 for I/O, memory and a failed
+ * internal check, 2 otherwise (bad input); 0 for SPH_OK. */
 int sph_app_exit_code(sph_status st);
 
 #define SPH_MAX_SETS 64

@@ -148,6 +148,7 @@ int sph_app_exit_code(sph_status st) {
     return SPH_EXIT_OK;
   case SPH_ERR_IO:
   case SPH_ERR_NOMEM:
+  case SPH_ERR_INTERNAL: /* a failed check of the library's own invariants */
     return SPH_EXIT_IO;
   default:
     return SPH_EXIT_USAGE;

@@ -14,6 +14,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/check.h"
 #include "core/tensor.h"
 
 #define RCOND_DEFAULT 1e-10
@@ -34,10 +35,27 @@ static double block_norm1(const double A[9], int dim) {
   return best;
 }
 
+/* Whether Ainv A is the identity in the leading dim x dim block to within
+ * the round-off the reciprocal condition number rc allows. */
+static int inverse_ok(const double A[9], const double Ainv[9], int dim,
+                      double rc) {
+  double tol = 1e3 * DBL_EPSILON / rc;
+  for (int i = 0; i < dim; ++i)
+    for (int j = 0; j < dim; ++j) {
+      double s = 0.0;
+      for (int k = 0; k < dim; ++k)
+        s += Ainv[3 * i + k] * A[3 * k + j];
+      if (!(fabs(s - (i == j)) <= tol))
+        return 0;
+    }
+  return 1;
+}
+
 /* Inverts the leading dim x dim block of A; the rest of Ainv is the
  * identity. Returns the reciprocal 1-norm condition number of the block,
  * computed from the adjugate so that nothing is divided by a vanishing
- * determinant; Ainv is written only when the result is >= rmin. */
+ * determinant; Ainv is written only when the result is >= rmin. With
+ * SPH_DEBUG_CHECKS, -1 when Ainv A is not the identity (inverse_ok). */
 static double invert_block(const double A[9], int dim, double rmin,
                            double Ainv[9]) {
   double P[9], H[9];
@@ -61,6 +79,8 @@ static double invert_block(const double A[9], int dim, double rmin,
   for (int i = dim; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       Ainv[3 * i + j] = Ainv[3 * j + i] = (i == j);
+  if (SPH_DEBUG_CHECKS_ON && !inverse_ok(A, Ainv, dim, rc))
+    return -1.0;
   return rc;
 }
 
@@ -69,6 +89,36 @@ static void mark_bad(long *bad, long a) {
 #pragma omp critical(sph_corrections_bad)
   if (a < *bad)
     *bad = a;
+}
+
+/* mark_bad into bad for a singular matrix (r -1), into wrong for an
+ * inverse that a debug check found wrong (r -2) */
+static void mark_failed(long *bad, long *wrong, long a, int r) {
+  mark_bad(r < -1 ? wrong : bad, a);
+}
+
+/* The cloud the corrections read: lists for (at least) its points and a
+ * kernel of positive support. */
+static sph_status check_cloud(const sph_cloud *c, sph_error *err) {
+  SPH_CHECK(c->nl && c->nl->n >= c->n && c->x && c->volume, err,
+            "correction cloud of %zu points with lists of %zu", c->n,
+            c->nl ? c->nl->n : 0);
+  SPH_CHECK(c->kernel && c->kernel->support > 0.0 && c->dim >= 1 && c->dim <= 3,
+            err, "correction cloud: kernel support %g, dimension %d",
+            c->kernel ? c->kernel->support : 0.0, c->dim);
+  return SPH_OK;
+}
+
+/* SPH_DEBUG_CHECKS: `wrong` (n: none) is the first particle whose moment
+ * matrix times its computed inverse is not the identity */
+static sph_status check_inverse(const sph_cloud *c, long wrong,
+                                sph_error *err) {
+  SPH_CHECK(wrong == (long)c->n, err,
+            "moment matrix of particle %lld: its inverse times it is not "
+            "the identity",
+            c->id && wrong < (long)c->n ? (long long)c->id[wrong]
+                                        : (long long)wrong);
+  return SPH_OK;
 }
 
 static sph_status singular(const sph_cloud *c, long a, const char *what,
@@ -179,8 +229,9 @@ static int w1_coefficients(const sph_cloud *c, size_t a, double rmin,
     }
   }
   double Pinv[9];
-  if (invert_block(Phi, dim, rmin, Pinv) < rmin)
-    return -1;
+  double rc = invert_block(Phi, dim, rmin, Pinv);
+  if (rc < rmin)
+    return rc < 0.0 ? -2 : -1;
   for (int i = dim; i < 3; ++i)
     Pinv[4 * i] = 0.0; /* unused directions carry no correction */
   /* beta = -Phi^-1 vphi (eq. 7), alpha = 1 / (phi + beta . vphi) (eq. 8) */
@@ -267,8 +318,9 @@ static int corrected_point(const sph_cloud *c, sph_gradient_kind kind, size_t a,
   }
   if (kind == SPH_GRAD_UNCORRECTED)
     return 0;
-  if (invert_block(M, c->dim, rmin, La) < rmin)
-    return -1;
+  double rc = invert_block(M, c->dim, rmin, La);
+  if (rc < rmin)
+    return rc < 0.0 ? -2 : -1;
   for (size_t s = nl->offset[a]; grad && s < nl->offset[a + 1]; ++s)
     sph_mat3_vec(La, grad + 3 * s, grad + 3 * s);
   sph_mat3_vec(La, gs, gs);
@@ -291,8 +343,9 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
                                    double *grad, double *grad_self, double *L,
                                    sph_error *err) {
   const sph_neighbors *nl = c->nl;
-  long n = (long)c->n, bad = n;
+  long n = (long)c->n, bad = n, wrong = n;
   double rmin = rcond_min(c);
+  SPH_TRY(check_cloud(c, err));
   if ((int)kind < SPH_GRAD_UNCORRECTED || kind > SPH_GRAD_W1)
     return sph_error_set(err, SPH_ERR_ARG, "unknown gradient kind %d",
                          (int)kind);
@@ -301,6 +354,7 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double La[9], gs[3] = {0, 0, 0};
+    int r;
     if (partial_point(c, (size_t)a, 3, grad)) {
       nan_values(grad_self, (size_t)a, 3);
       nan_values(L, (size_t)a, 9);
@@ -309,8 +363,8 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
     sph_mat3_identity(La);
     if (kind == SPH_GRAD_W1) {
       w1_coef w;
-      if (w1_coefficients(c, (size_t)a, rmin, &w)) {
-        mark_bad(&bad, a);
+      if ((r = w1_coefficients(c, (size_t)a, rmin, &w)) != 0) {
+        mark_failed(&bad, &wrong, a, r);
         clear_slots(nl, (size_t)a, 3, grad);
         if (grad_self)
           memset(grad_self + 3 * a, 0, 3 * sizeof *grad_self);
@@ -322,9 +376,9 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
         gs[k] = (w.dalpha[k] + w.alpha * w.beta[k]) * W0;
       for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s)
         w1_slot(c, &w, (size_t)a, (size_t)nl->index[s], grad + 3 * s);
-    } else if (corrected_point(c, kind, (size_t)a, rmin, grad, gs, La, NULL,
-                               NULL)) {
-      mark_bad(&bad, a);
+    } else if ((r = corrected_point(c, kind, (size_t)a, rmin, grad, gs, La,
+                                    NULL, NULL)) != 0) {
+      mark_failed(&bad, &wrong, a, r);
       if (grad)
         clear_slots(nl, (size_t)a, 3, grad);
       if (grad_self)
@@ -336,6 +390,7 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
     if (L)
       memcpy(L + 9 * a, La, sizeof La);
   }
+  SPH_DEBUG_TRY(check_inverse(c, wrong, err));
   if (bad < n)
     return singular(c, bad, "gradient moment matrix", err);
   return SPH_OK;
@@ -344,8 +399,9 @@ sph_status sph_correction_gradient(const sph_cloud *c, sph_gradient_kind kind,
 sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
                                  double *wself, sph_error *err) {
   const sph_neighbors *nl = c->nl;
-  long n = (long)c->n, bad = n;
+  long n = (long)c->n, bad = n, wrong = n;
   double rmin = rcond_min(c);
+  SPH_TRY(check_cloud(c, err));
   if (order != 0 && order != 1)
     return sph_error_set(err, SPH_ERR_ARG,
                          "kernel correction order %d is not 0 or 1", order);
@@ -363,8 +419,9 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
       alpha = 1.0 / S;
     } else {
       w1_coef co;
-      if (w1_coefficients(c, (size_t)a, rmin, &co)) {
-        mark_bad(&bad, a);
+      int r = w1_coefficients(c, (size_t)a, rmin, &co);
+      if (r) {
+        mark_failed(&bad, &wrong, a, r);
         clear_slots(nl, (size_t)a, 1, w);
         wself[a] = 0.0;
         continue;
@@ -380,6 +437,7 @@ sph_status sph_correction_kernel(const sph_cloud *c, int order, double *w,
              sph_kernel_eval(c->kernel, r);
     }
   }
+  SPH_DEBUG_TRY(check_inverse(c, wrong, err));
   if (bad < n)
     return singular(c, bad, "kernel moment matrix", err);
   return SPH_OK;
@@ -513,6 +571,7 @@ sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
   const sph_neighbors *nl = c->nl;
   long n = (long)c->n, bad = n;
   double rmin = rcond_min(c);
+  SPH_TRY(check_cloud(c, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     double sol[4] = {0};
@@ -534,28 +593,30 @@ sph_status sph_correction_laplacian(const sph_cloud *c, double *lap,
 sph_status sph_correction_coefficients(const sph_cloud *c,
                                        sph_gradient_kind kind, int laplacian,
                                        double *coef, sph_error *err) {
-  long n = (long)c->n, bad = n;
+  long n = (long)c->n, bad = n, inv_bad = n;
   double rmin = rcond_min(c);
   int lap_bad = 0;
+  SPH_TRY(check_cloud(c, err));
   if (kind != SPH_GRAD_W1 && kind != SPH_GRAD_CORRECTED_W0)
     return sph_error_set(err, SPH_ERR_ARG,
                          "slot coefficients of gradient kind %d", (int)kind);
 #pragma omp parallel for schedule(static) reduction(| : lap_bad)
   for (long a = 0; a < n; ++a) {
     double *co = coef + SPH_CORRECTION_COEFS * a;
-    int wrong;
+    int wrong, r;
     if (partial_point(c, (size_t)a, 0, NULL)) {
       nan_values(coef, (size_t)a, SPH_CORRECTION_COEFS);
       continue;
     }
     if (kind == SPH_GRAD_W1) {
       w1_coef w;
-      wrong = w1_coefficients(c, (size_t)a, rmin, &w) != 0;
+      wrong = (r = w1_coefficients(c, (size_t)a, rmin, &w)) != 0;
       memcpy(co, &w, sizeof w);
     } else { /* S, gamma, L: 13 */
       double gs[3];
-      wrong = corrected_point(c, kind, (size_t)a, rmin, NULL, gs, co + 4, co,
-                              co + 1) != 0;
+      r = corrected_point(c, kind, (size_t)a, rmin, NULL, gs, co + 4, co,
+                          co + 1);
+      wrong = r != 0;
     }
     double sol[4] = {0};
     if (laplacian && laplacian_solution(c, (size_t)a, rmin, sol)) {
@@ -564,8 +625,9 @@ sph_status sph_correction_coefficients(const sph_cloud *c,
     }
     memcpy(co + 16, sol, sizeof sol);
     if (wrong)
-      mark_bad(&bad, a);
+      mark_failed(&bad, &inv_bad, a, r);
   }
+  SPH_DEBUG_TRY(check_inverse(c, inv_bad, err));
   if (bad < n)
     return singular(c, bad,
                     lap_bad ? "kernel or Laplacian moment matrix"

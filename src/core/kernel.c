@@ -5,6 +5,8 @@
  * functions of the matching smoothness for d = 1 are used. */
 #include "core/kernel.h"
 
+#include "core/check.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -141,6 +143,10 @@ sph_status sph_kernel_create(sph_kernel *k, sph_kernel_type type, int dim,
   k->kappa = type == SPH_KERNEL_QUINTIC ? 3.0 : 2.0;
   k->support = k->kappa * h;
   k->norm = kernel_sigma(type, dim) / pow(h, dim);
+  SPH_CHECK(k->support > 0.0 && isfinite(k->support) && k->norm > 0.0 &&
+                isfinite(k->norm),
+            err, "%s kernel of h = %g: support %g, normalisation %g",
+            kernel_names[type], h, k->support, k->norm);
   return SPH_OK;
 }
 

@@ -3,6 +3,8 @@
  * by index). DESIGN.md sec. 5. */
 #include "core/neighbors.h"
 
+#include "core/check.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,8 +103,13 @@ static sph_status finish_offsets(sph_neighbors *nl, size_t n, sph_error *err) {
     nl->offset[a + 1] += nl->offset[a];
   nl->n = n;
   nl->count = nl->offset[n];
-  return grow((void **)&nl->index, &nl->capacity, nl->count ? nl->count : 1,
-              sizeof *nl->index, err, "indices");
+  SPH_TRY(grow((void **)&nl->index, &nl->capacity, nl->count ? nl->count : 1,
+               sizeof *nl->index, err, "indices"));
+  SPH_CHECK(nl->n <= nl->capacity_n && nl->count <= nl->capacity, err,
+            "neighbour lists of %zu particles, %zu pairs exceed their "
+            "buffers (%zu, %zu)",
+            nl->n, nl->count, nl->capacity_n, nl->capacity);
+  return SPH_OK;
 }
 
 static sph_status reserve_offsets(sph_neighbors *nl, size_t n, sph_error *err) {
@@ -139,6 +146,7 @@ sph_status sph_neighbors_build_brute(sph_neighbors *nl, const double *x,
       if (b != a && pair_kept(body, filter, a, b) && dist2(x, a, b, dim) < r2)
         nl->index[k++] = (int32_t)b;
   }
+  SPH_DEBUG_TRY(sph_neighbors_check(nl, x, dim, radius, err));
   return SPH_OK;
 }
 
@@ -289,11 +297,78 @@ sph_status sph_neighbors_build(sph_neighbors *nl, const double *x, size_t n,
     nl->offset[a + 1] = scan(nl, &g, x, (size_t)a, dim, r2, body, filter, NULL);
   if ((st = finish_offsets(nl, n, err)) != SPH_OK)
     return st;
-#pragma omp parallel for schedule(static)
+  long short_list = nn; /* the first list whose fill differs from its count */
+#pragma omp parallel for schedule(static) reduction(min : short_list)
   for (long a = 0; a < nn; ++a) {
     int32_t *list = nl->index + nl->offset[a];
     size_t k = scan(nl, &g, x, (size_t)a, dim, r2, body, filter, list);
+    if (k != nl->offset[a + 1] - nl->offset[a])
+      short_list = a < short_list ? a : short_list;
     sort_list(list, k);
   }
+  SPH_CHECK(short_list == nn, err,
+            "neighbour list of particle %ld: the fill found other "
+            "neighbours than the count",
+            short_list);
+  SPH_DEBUG_TRY(sph_neighbors_check(nl, x, dim, radius, err));
+  return SPH_OK;
+}
+
+/* whether `v` is in the ascending list v[0..k) */
+static int listed(const int32_t *list, size_t k, int32_t v) {
+  size_t lo = 0, hi = k;
+  while (lo < hi) {
+    size_t mid = lo + (hi - lo) / 2;
+    if (list[mid] == v)
+      return 1;
+    if (list[mid] < v)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return 0;
+}
+
+sph_status sph_neighbors_check(const sph_neighbors *nl, const double *x,
+                               int dim, double radius, sph_error *err) {
+  size_t n = nl->n;
+  SPH_CHECK(nl->offset && nl->offset[0] == 0 && nl->offset[n] == nl->count, err,
+            "neighbour offsets: first %zu, last %zu for %zu pairs",
+            nl->offset ? nl->offset[0] : 0, nl->offset ? nl->offset[n] : 0,
+            nl->count);
+  double r2 = radius * radius;
+  for (size_t a = 0; a < n; ++a) {
+    size_t lo = nl->offset[a], hi = nl->offset[a + 1];
+    SPH_CHECK(lo <= hi && hi <= nl->count, err,
+              "neighbour offsets of particle %zu: [%zu, %zu) of %zu pairs", a,
+              lo, hi, nl->count);
+    for (size_t k = lo; k < hi; ++k) {
+      int32_t b = nl->index[k];
+      SPH_CHECK(b >= 0 && (size_t)b < n && (size_t)b != a, err,
+                "neighbour list of particle %zu holds %d (of %zu particles)", a,
+                (int)b, n);
+      int32_t prev = k > lo ? nl->index[k - 1] : -1;
+      SPH_CHECK(prev < b, err,
+                "neighbour list of particle %zu is not strictly ascending "
+                "(%d after %d)",
+                a, (int)b, (int)prev);
+      double d2 = dist2(x, a, (size_t)b, dim);
+      SPH_CHECK(d2 < r2, err,
+                "neighbour %d of particle %zu is %g away, beyond the radius "
+                "%g",
+                (int)b, a, sqrt(d2), radius);
+    }
+  }
+  /* symmetry, once every list is known to be sorted */
+  for (size_t a = 0; a < n; ++a)
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      int32_t b = nl->index[k];
+      SPH_CHECK(listed(nl->index + nl->offset[b],
+                       nl->offset[b + 1] - nl->offset[b], (int32_t)a),
+                err,
+                "neighbour lists not symmetric: %d is in the list of %zu, "
+                "not %zu in that of %d",
+                (int)b, a, a, (int)b);
+    }
   return SPH_OK;
 }

@@ -52,6 +52,15 @@ sph_status sph_neighbors_build(sph_neighbors *nl, const double *x, size_t n,
 double sph_neighbors_grid(const double lo[3], const double hi[3], size_t n,
                           int dim, double radius, long nc[3]);
 
+/* Whether nl keeps the contract above for points x (dim, radius): every
+ * index in [0, n) and not the particle's own, each list strictly ascending,
+ * every neighbour closer than radius, and the lists symmetric (b in a's
+ * list exactly when a is in b's). SPH_ERR_INTERNAL naming the first
+ * particle and pair that break it. O(N k log k) for k neighbours; run after
+ * every build with SPH_DEBUG_CHECKS (core/check.h). */
+sph_status sph_neighbors_check(const sph_neighbors *nl, const double *x,
+                               int dim, double radius, sph_error *err);
+
 /* Reference O(N^2) search with the same contract (tests, debug checks). */
 sph_status sph_neighbors_build_brute(sph_neighbors *nl, const double *x,
                                      size_t n, int dim, double radius,

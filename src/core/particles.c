@@ -2,6 +2,7 @@
  * mirror images of symmetry planes and the momentum sums. */
 #include "core/particles.h"
 
+#include "core/check.h"
 #include "core/tensor.h"
 
 #include <math.h>
@@ -173,6 +174,10 @@ sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
   size_t n = ps->n;
   if (n < 2 || !(cell > 0.0))
     return SPH_OK;
+  for (size_t a = 0; a < n; ++a)
+    SPH_CHECK(ps->id[a] >= 0 && (size_t)ps->id[a] < n, err,
+              "particle order: id %lld of %zu particles", (long long)ps->id[a],
+              n);
   const double *X = ps->field[SPH_FIELD_POSITION0];
   double lo[3] = {INFINITY, INFINITY, INFINITY};
   for (size_t a = 0; a < n; ++a)
@@ -204,6 +209,12 @@ sph_status sph_particles_sort_morton(sph_particles *ps, double cell,
   ps->slot = slot;
   free(k);
   free(tmp);
+  /* outputs list particles through slot: it must invert the reorder */
+  for (size_t j = 0; j < n; ++j)
+    SPH_CHECK(slot[j] >= 0 && (size_t)slot[j] < n &&
+                  ps->id[slot[j]] == (int64_t)j,
+              err, "particle order: slot %lld of the particle created %zu-th",
+              (long long)slot[j], j);
   return SPH_OK;
 }
 

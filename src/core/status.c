@@ -1,6 +1,8 @@
 /* Status messages and the error record (see include/sph/status.h). */
 #include "sph/status.h"
 
+#include "core/check.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -148,6 +150,20 @@ sph_status sph_error_at(sph_error *err, sph_status code, const char *file,
   sph_error_atv(err, code, file, line, col, key, fmt, ap);
   va_end(ap);
   return code;
+}
+
+sph_status sph_check_failed(sph_error *err, sph_status code, const char *file,
+                            int line, const char *fmt, ...) {
+  /* the path from the last src/ folder on (the build's paths are absolute) */
+  for (const char *p = file; (p = strstr(p, "src/")) != NULL; ++p)
+    if (p == file || p[-1] == '/')
+      file = p;
+  char msg[sizeof err->message];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  return sph_error_set(err, code, "%s:%d: %s", file, line, msg);
 }
 
 void sph_error_format(const sph_error *err, char *buf, size_t size) {

@@ -3,6 +3,7 @@
  * 4). The loop calls method->stable_dt and method->step once per step. */
 #include "solver/sim.h"
 
+#include "core/check.h"
 #include "core/tensor.h"
 #include "parallel/domain.h"
 #include "scene/geometry.h"
@@ -197,6 +198,69 @@ static sph_status check_distributed_terms(const sph_sim *sim, sph_error *err) {
   return SPH_OK;
 }
 
+/* The sim's own structure, the same on every rank: the method's hooks, the
+ * terms and the timers within their tables (O(terms)). */
+static sph_status check_sim(const sph_sim *sim, sph_error *err) {
+  const sph_method_ops *m = sim->method;
+  SPH_CHECK(sim->ps && m && m->step && m->stable_dt && m->derive && m->energy &&
+                m->state,
+            err, "simulation without particles or a method hook");
+  SPH_CHECK(sim->nterms >= 0 && sim->nterms <= SPH_MAX_TERMS, err,
+            "%d terms (table of %d)", sim->nterms, SPH_MAX_TERMS);
+  for (int i = 0; i < sim->nterms; ++i)
+    SPH_CHECK(sim->terms[i].ops && sim->terms[i].ops->name, err,
+              "term %d has no ops table", i);
+  SPH_CHECK(sim->ntimers >= 0 && sim->ntimers <= SPH_MAX_TIMERS &&
+                sim->timer_stable_dt >= 0 &&
+                sim->timer_stable_dt < sim->ntimers,
+            err, "timer %d of %d (table of %d)", sim->timer_stable_dt,
+            sim->ntimers, SPH_MAX_TIMERS);
+  return SPH_OK;
+}
+
+/* This rank's particle set: its count within its capacity, the arrays
+ * every particle has (O(1)). */
+static sph_status check_particles(const sph_particles *ps, sph_error *err) {
+  SPH_CHECK(ps->n <= ps->capacity && ps->dim >= 1 && ps->dim <= 3, err,
+            "%zu particles in a set of %zu (dimension %d)", ps->n, ps->capacity,
+            ps->dim);
+  SPH_CHECK(ps->field[SPH_FIELD_POSITION0] && ps->field[SPH_FIELD_VOLUME0] &&
+                ps->id && ps->body && ps->flags,
+            err, "particle set without positions, volumes or attributes");
+  return SPH_OK;
+}
+
+/* SPH_DEBUG_CHECKS: the method's state arrays x, p or v and F hold finite
+ * values (after a step: SPH_ERR_NUMERIC, the verdict's `nan`, which the
+ * next step's time step would report at the same time), and at set-up
+ * every F has det F > 0 (O(N) over the arrays; collective). */
+static sph_status check_state(sph_sim *sim, int setup, sph_error *err) {
+  sph_state_array arr[SPH_MAX_STATE];
+  int k = sim->method->state(sim, arr);
+  SPH_CHECK(k >= 0 && k <= SPH_MAX_STATE, err, "%s: %d state arrays",
+            sim->method->name, k);
+  for (int i = 0; i < k; ++i) {
+    const char *name = arr[i].name;
+    const double *v = arr[i].data;
+    if (strcmp(name, "x") && strcmp(name, "p") && strcmp(name, "v") &&
+        strcmp(name, "F"))
+      continue;
+    size_t j = 0;
+    while (j < arr[i].len && isfinite(v[j]))
+      ++j;
+    SPH_CHECK_AS(SPH_ERR_NUMERIC, j == arr[i].len, err,
+                 "%s: state %s[%zu] is %g at t = %g (step %lu)",
+                 sim->method->name, name, j, j < arr[i].len ? v[j] : 0.0,
+                 sim->t, sim->steps);
+    for (size_t a = 0; setup && !strcmp(name, "F") && a + 9 <= arr[i].len;
+         a += 9)
+      SPH_CHECK(sph_mat3_det(v + a) > 0.0, err,
+                "%s: det F = %g at set-up (entry %zu of F)", sim->method->name,
+                sph_mat3_det(v + a), a / 9);
+  }
+  return SPH_OK;
+}
+
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err) {
   *out = NULL;
@@ -264,6 +328,8 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   /* a rank whose set-up failed alone must not leave the others waiting */
   if (sim->domain)
     st = sph_domain_agree(sim->domain, st, err);
+  if (st == SPH_OK && SPH_DEBUG_CHECKS_ON)
+    st = sph_domain_agree(sim->domain, check_state(sim, 1, err), err);
   if (st == SPH_OK)
     st = check_distributed_terms(sim, err);
   if (st == SPH_OK)
@@ -271,6 +337,8 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   /* the time step rule (a wave speed per particle) is work of every step */
   if (st == SPH_OK)
     sim->timer_stable_dt = sph_sim_add_timer(sim, "stable_dt");
+  if (st == SPH_OK)
+    st = check_sim(sim, err);
   if (st != SPH_OK) {
     sph_sim_destroy(sim);
     return st;
@@ -303,6 +371,7 @@ double sph_sim_stable_dt(sph_sim *sim) {
 }
 
 sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
+  SPH_TRY(check_sim(sim, err));
   double t0 = sph_wtime();
   double dt = sph_sim_stable_dt(sim);
   sim->timers[sim->timer_stable_dt].seconds += sph_wtime() - t0;
@@ -321,7 +390,14 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
   sim->dt_stable_peak = fmax(sim->dt_stable_peak, dt);
   if (dt > dt_cap)
     dt = dt_cap;
+  /* dt_cap is the same on every rank */
+  SPH_CHECK(dt > 0.0 && isfinite(dt), err,
+            "time step %g at t = %g (stable %g, cap %g)", dt, sim->t,
+            sim->dt_stable_peak, dt_cap);
   sph_status st = sim->method->step(sim, dt, err);
+  /* a rank's failed check reaches every rank through the agreement */
+  if (st == SPH_OK)
+    st = check_particles(sim->ps, err);
   st = sph_domain_agree(sim->domain, st, err);
   if (st != SPH_OK)
     return st;
@@ -330,5 +406,7 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
   sim->dt_last = dt;
   sim->dt_min = dt < sim->dt_min ? dt : sim->dt_min;
   sim->dt_max = dt > sim->dt_max ? dt : sim->dt_max;
+  if (SPH_DEBUG_CHECKS_ON)
+    return sph_domain_agree(sim->domain, check_state(sim, 0, err), err);
   return SPH_OK;
 }
