@@ -234,10 +234,16 @@ static sph_status output_frame(sph_run *run, int index, sph_error *err) {
   return st;
 }
 
-/* a failed step or output: an I/O failure ends the run as failed, any
- * other trips the verdict's step (or nan) indicator */
+/* an I/O failure or a broken invariant of the code (src/core/check.h) ends
+ * the run as failed, with no verdict */
+static int run_broken(sph_status st) {
+  return st == SPH_ERR_IO || st == SPH_ERR_INTERNAL;
+}
+
+/* a failed step or output: a broken run ends as failed, any other failure
+ * trips the verdict's step (or nan) indicator */
 static void run_fail(sph_run *run) {
-  if (run->st != SPH_OK && run->st != SPH_ERR_IO)
+  if (run->st != SPH_OK && !run_broken(run->st))
     sph_verdict_fail_step(run->verdict, run->sim->t, &run->err);
 }
 
@@ -343,7 +349,7 @@ static sph_status run_loop(sph_run *run, double t_stop, unsigned long max_steps,
       run_stop(run, stop);
     run_fail(run);
   }
-  if (run->st == SPH_ERR_IO) {
+  if (run_broken(run->st)) {
     if (err)
       *err = run->err;
     return run->st;
@@ -386,7 +392,7 @@ sph_status sph_run_create_hooked(sph_run **out, const sph_scene *scene,
     st = sph_run_start(run, err);
   if (st == SPH_OK)
     run_begin(run);
-  if (st == SPH_OK && run->st == SPH_ERR_IO) {
+  if (st == SPH_OK && run_broken(run->st)) {
     st = run->st;
     if (err)
       *err = run->err;
@@ -410,7 +416,7 @@ static const char *signal_name(int signo) {
 }
 
 sph_run_state sph_run_state_of(const sph_run *run) {
-  if (run->st == SPH_ERR_IO || run->report.io_failed)
+  if (run_broken(run->st) || run->report.io_failed)
     return SPH_RUN_FAILED;
   if (run->verdict && !run->verdict->stable)
     return SPH_RUN_UNSTABLE;
@@ -501,7 +507,7 @@ sph_status sph_run_close(sph_run *run, sph_summary *summary, sph_error *err) {
   int completed = run->st == SPH_OK && run->verdict->stable && !run->stopped;
   r->stop_signal = run->stopped;
   r->stopped_by = run->stopped ? signal_name(run->stopped) : NULL;
-  r->io_failed = run->st == SPH_ERR_IO;
+  r->io_failed = run_broken(run->st);
   sinks_close(run, r);
   r->sinks = run->sinks;
   r->nsinks = run->nsinks;
