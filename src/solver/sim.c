@@ -266,26 +266,9 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   *out = NULL;
   sph_node *name_node = sph_node_child(scene->method, "name");
   const sph_method_ops *method = sph_method_find(scene->method_name);
-  if (!method) {
-    const char *names[16];
-    size_t k = 0;
-    for (const sph_method_ops *const *m = sph_method_list(); *m && k < 15; ++m)
-      names[k++] = (*m)->name;
-    names[k] = NULL;
-    const char *hint = sph_suggest(scene->method_name, names);
-    char known[256] = "";
-    for (size_t i = 0; i < k; ++i) {
-      strncat(known, i ? ", " : "", sizeof known - strlen(known) - 1);
-      strncat(known, names[i], sizeof known - strlen(known) - 1);
-    }
-    if (hint)
-      return sph_node_error(
-          name_node ? name_node : scene->method, err, SPH_ERR_ARG,
-          "unknown method '%s'; did you mean '%s'?", scene->method_name, hint);
-    return sph_node_error(name_node ? name_node : scene->method, err,
-                          SPH_ERR_ARG, "unknown method '%s' (known: %s)",
-                          scene->method_name, known);
-  }
+  if (!method)
+    return sph_method_unknown(scene->method_name,
+                              name_node ? name_node : scene->method, err);
   sph_sim *sim = calloc(1, sizeof *sim);
   if (!sim)
     return sph_error_set(err, SPH_ERR_NOMEM, "simulation");
