@@ -1,5 +1,5 @@
 /* sph bench: a fixed suite of throughput cases built from the shipped scenes
- * (DESIGN.md sec. 1), each run in its own child process so that its peak
+ * (docs/design.md sec. 1), each run in its own child process so that its peak
  * memory (the child's maximum resident set) is its own, on one thread and
  * on every core. Prints a table and, with --json FILE, writes the figures.
  * It times the solver's own steps and timers (those summary.json reports);

@@ -1,5 +1,5 @@
 /* sph: a headless simulator for large-strain elastic solid dynamics with
- * SPH. Dispatches to the sub-commands (DESIGN.md sec. 1). */
+ * SPH. Dispatches to the sub-commands (docs/design.md sec. 1). */
 #include <errno.h>
 #include <omp.h>
 #include <signal.h>

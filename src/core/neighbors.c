@@ -1,6 +1,6 @@
 /* Neighbour search: cell lists (cell size >= search radius) into compact CSR
  * lists, deterministic for any thread count (each particle's list is sorted
- * by index). DESIGN.md sec. 5. */
+ * by index). docs/design.md sec. 5. */
 #include "core/neighbors.h"
 
 #include "core/check.h"

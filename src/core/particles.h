@@ -104,9 +104,9 @@ static inline size_t sph_particles_slot(const sph_particles *ps, size_t j) {
 }
 
 /* Mirror (ghost) images of real particles across symmetry planes (seed 000
- * sec. 8.2, BENCHMARKS D.1): particle n_real + g is the image of src[g].
- * A vector of the image is S v with S = diag(vsign[3g..3g+2]) when every
- * plane is a coordinate plane, else S = vmat[9g..9g+8] (row-major: sigma
+ * sec. 8.2, docs/benchmarks.md D.1): particle n_real + g is the image of
+ * src[g]. A vector of the image is S v with S = diag(vsign[3g..3g+2]) when
+ * every plane is a coordinate plane, else S = vmat[9g..9g+8] (row-major: sigma
  * times the composed reflections I - 2 n n^T); a scalar's departure from its
  * reference value flips by ssign[g] (sigma). Terms that read neighbours'
  * values refresh images with sph_mirror_vector/scalar. */

@@ -1,4 +1,4 @@
-/* Checkpoints (DESIGN.md sec. 7): a versioned binary snapshot of what
+/* Checkpoints (docs/design.md sec. 7): a versioned binary snapshot of what
  * determines every later step of a run, so `sph run --resume DIR` continues
  * exactly where a killed run left off.
  *

@@ -1,4 +1,4 @@
-/* Output sinks (DESIGN.md sec. 2, 4): each consumes the same read-only
+/* Output sinks (docs/design.md sec. 2, 4): each consumes the same read-only
  * Frame at every output time; no sink recomputes physics. */
 #ifndef SPH_SINK_H
 #define SPH_SINK_H

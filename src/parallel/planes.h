@@ -1,5 +1,5 @@
 /* Reflection through a symmetry or skew-symmetry plane X . n = at (seed 000
- * sec. 8.2, BENCHMARKS.md D.1): the one implementation of the geometry of
+ * sec. 8.2, docs/benchmarks.md D.1): the one implementation of the geometry of
  * mirror images, used by the methods' image particles
  * (methods/common/images.c) and by the domain's reflected boxes, which find
  * the ghosts the images' sources are (parallel/domain_fixed.c,

@@ -1,7 +1,7 @@
 /* Geometry: signed distance functions of the scene shapes, their bounds and
  * exact measures, and the particle sets that fill them:
  *   - a box lattice with particles on the faces and tributary volumes
- *     (BENCHMARKS.md D.5: sum V = body volume);
+ *     (docs/benchmarks.md D.5: sum V = body volume);
  *   - a cell-centred lattice, tiling a box exactly, clipped to other shapes;
  *   - seeded uniform jitter (splitmix64).
  * The relaxation to a uniform, irregular distribution is in relax.c. */

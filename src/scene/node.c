@@ -1,4 +1,4 @@
-/* The scene tree (no paper: input handling, DESIGN.md sec. 6): nodes that
+/* The scene tree (no paper: input handling, docs/design.md sec. 6): nodes that
  * keep their file, line, column and dotted path; lookups, errors at a node,
  * Levenshtein "did you mean" hints and the check of a map's keys; scalar
  * conversions and the typed getters that fill defaults and mark keys used.

@@ -1,4 +1,4 @@
-/* The scene tree in and out of YAML (no paper: input handling, DESIGN.md
+/* The scene tree in and out of YAML (no paper: input handling, docs/design.md
  * sec. 6): a document read with libyaml's document API and copied into
  * nodes (duplicate keys rejected, aliases bounded, flow nesting limited
  * before the parser); --set overrides "a.b=value"; a block YAML writer on

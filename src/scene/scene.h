@@ -1,4 +1,4 @@
-/* A validated, typed scene (DESIGN.md sec. 6) and the particles it makes.
+/* A validated, typed scene (docs/design.md sec. 6) and the particles it makes.
  *
  * sph_scene_load reads a YAML scene, applies --set overrides, validates
  * every key (errors name file, line, column and key) and fills defaults.
@@ -39,7 +39,7 @@ typedef struct sph_shape {
 
 typedef enum sph_lattice {
   SPH_LATTICE_FACES,       /* particles on the faces: count [nx,ny,nz] on a
-                              box, dp = L/(n-1), tributary volumes (BENCHMARKS
+                              box, dp = L/(n-1), tributary volumes (docs/benchmarks.md
                               D.5) */
   SPH_LATTICE_CELL_CENTRED /* spacing dp, cell centres clipped to the shape,
                               V = dp^d */
@@ -119,7 +119,7 @@ typedef enum sph_condition_kind {
   SPH_BC_ROLLER,       /* normal component fixed to zero (symmetry plane) */
   SPH_BC_VELOCITY,     /* velocity prescribed over [from, until) */
   SPH_BC_SYMMETRY,     /* mirror plane: ghosts reflect positions, negate the
-                          normal velocity component (BENCHMARKS D.1) */
+                          normal velocity component (docs/benchmarks.md D.1) */
   SPH_BC_SKEW_SYMMETRY /* mirror plane: ghosts negate the tangential
                           components */
 } sph_condition_kind;

@@ -1,5 +1,5 @@
-/* The scene schema (DESIGN.md sec. 6): the top-level keys, the kernel, time
- * and stability blocks, the loader (YAML tree, --set overrides, every
+/* The scene schema (docs/design.md sec. 6): the top-level keys, the kernel,
+ * time and stability blocks, the loader (YAML tree, --set overrides, every
  * section checked, typed and defaulted, with errors at the file, line,
  * column and key) and the helpers the section files share (schema_impl.h):
  * axes and directions (x, y, z or any vector), lists and one-of choices.

@@ -1,4 +1,4 @@
-/* The run (include/sph/sph.h; DESIGN.md sec. 1-2): the loop over a scene's
+/* The run (include/sph/sph.h; docs/design.md sec. 1-2): the loop over a scene's
  * output times that `sph run`, sph bench, the stability tests and embedding
  * programs share. It steps the method, lands exactly on every output time,
  * hands each frame to the sinks of the registry (io/sink_list.h) and to the

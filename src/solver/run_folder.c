@@ -1,4 +1,4 @@
-/* The run's output folder (DESIGN.md sec. 2): one run per folder (a lock),
+/* The run's output folder (docs/design.md sec. 2): one run per folder (a lock),
  * --overwrite removing only the files an earlier run of ours wrote, and
  * scene_used.yaml. */
 #include <dirent.h>

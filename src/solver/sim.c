@@ -1,6 +1,6 @@
 /* The simulation object and its time step: particles from the scene, the
- * method from the registry, the terms the method created (DESIGN.md sec. 2,
- * 4). The loop calls method->stable_dt and method->step once per step. */
+ * method from the registry, the terms the method created (docs/design.md sec.
+ * 2, 4). The loop calls method->stable_dt and method->step once per step. */
 #include "solver/sim.h"
 
 #include "core/check.h"

@@ -1,5 +1,5 @@
 /* A simulation: the particles a scene makes, the method that advances them
- * and the terms the scene asked for (DESIGN.md sec. 2 and 4).
+ * and the terms the scene asked for (docs/design.md sec. 2 and 4).
  *
  * Methods and terms plug in through small run-time ops tables (as SUNDIALS'
  * N_Vector_Ops): the time loop calls method->stable_dt and method->step once

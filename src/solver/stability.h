@@ -10,13 +10,13 @@
  *    energy of a uniform strain of about 1e-10, 1e12 times the round-off
  *    energy of double-precision states) is never judged, so a body at rest
  *    does not trip on round-off;
- *  - pressure checkerboard: the red-black mode fraction of BENCHMARKS.md
+ *  - pressure checkerboard: the red-black mode fraction of docs/benchmarks.md
  *    D.3, C = |sum V s (p - pbar)| / sqrt(sum V * sum V (p - pbar)^2) with
  *    s_a = (-1)^(i+j+k) the parity of the particle's lattice index (bodies
  *    made from a lattice, jittered or not; relaxed bodies carry no parity).
  *    0 <= C <= 1: about 0 for smooth fields, 1 for a pure red-black
  *    alternation; tripped above SPH_CHECKERBOARD_MAX;
- *  - numerical fracture (seed 002 sec. 6.1, 6.3; BENCHMARKS.md E.5): the
+ *  - numerical fracture (seed 002 sec. 6.1, 6.3; docs/benchmarks.md E.5): the
  *    pairs of particles of one body that are initially adjacent (reference
  *    distance <= SPH_FRACTURE_ADJACENT dp, dp the body's spacing) are listed
  *    once; at every frame the largest current distance of a listed pair, in

@@ -1,4 +1,4 @@
-/* The terms a method composes and the method's named timers (DESIGN.md
+/* The terms a method composes and the method's named timers (docs/design.md
  * sec. 4): methods add them in setup; each rates / constrain hook is run in
  * order and timed for summary.json's terms; the list of every term's ops
  * table (term_list.h). */

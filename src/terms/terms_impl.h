@@ -1,5 +1,5 @@
-/* Terms a method composes (DESIGN.md sec. 4): each is an sph_term_ops table
- * plus a create function that adds it to the sim only when asked for. */
+/* Terms a method composes (docs/design.md sec. 4): each is an sph_term_ops
+ * table plus a create function that adds it to the sim only when asked for. */
 #ifndef SPH_TERMS_IMPL_H
 #define SPH_TERMS_IMPL_H
 

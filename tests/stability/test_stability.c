@@ -1,4 +1,4 @@
-/* Hard cases at CI size (BENCHMARKS.md A2, A4, A5): each run's verdict and
+/* Hard cases at CI size (docs/benchmarks.md A2, A4, A5): each run's verdict and
  * the indicator for its failure mode, measured through the same verdict the
  * sph command uses (the configurations every indicator must flag are in
  * test_indicators.c). */
@@ -8,8 +8,8 @@
 
 START_TEST(twisting_column_nearly_incompressible) {
   /* A2 at nu = 0.499, 5 x 25 x 5, to 0.25 s. Seed 000 Fig. 28 shows {p,F}
-   * breaking down; an independent implementation (BENCHMARKS D.3) and this
-   * one find {p,F} noisier but not divergent at this size, so the test
+   * breaking down; an independent implementation (docs/benchmarks.md D.3) and
+   * this one find {p,F} noisier but not divergent at this size, so the test
    * asserts what is measured: both stable, {p,F,J} smoother. */
   const char *pf[] = {"method.fields=pF", "method.jst.eps4_J=0",
                       "time.end=0.25"};

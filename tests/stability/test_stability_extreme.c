@@ -1,4 +1,4 @@
-/* The extreme hard cases at CI size (BENCHMARKS.md A3, B10, B4 long time,
+/* The extreme hard cases at CI size (docs/benchmarks.md A3, B10, B4 long time,
  * A8 at 0.08 c0): each run's verdict and the indicator of its failure mode,
  * through the same verdict the sph command uses (stability_run.h). */
 #include "stability_run.h"

@@ -1,4 +1,4 @@
-/* The peer's extreme twist (BENCHMARKS.md A3, issue 14 item 4a): the A1
+/* The peer's extreme twist (docs/benchmarks.md A3, issue 14 item 4a): the A1
  * column at Omega = 400 rad/s on SPHinXsys' lattice (10 x 61 x 10) with
  * seed 004's method (scenes/twisting_column_bond.yaml), to the peer's end
  * time 0.5 s: stable, no inversion, the energy never above its start.

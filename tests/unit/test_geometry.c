@@ -1,6 +1,6 @@
 /* Geometry and expressions: signed distances, exact measures, face lattices
- * with tributary volumes (BENCHMARKS.md D.5), clipped cell-centred lattices,
- * seeded jitter, relaxation, libmatheval expressions. */
+ * with tributary volumes (docs/benchmarks.md D.5), clipped cell-centred
+ * lattices, seeded jitter, relaxation, libmatheval expressions. */
 #include "test_util.h"
 
 #include <float.h>

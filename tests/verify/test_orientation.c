@@ -4,8 +4,8 @@
  * by 37 degrees about [1, 2, 3] give the same energy, |linear momentum|,
  * |angular momentum| and wave arrival histories, as does the 2D tensile
  * plate (B11, ul-sph) turned by 30 degrees; a half cube with a
- * symmetry or skew-symmetry mirror plane (BENCHMARKS D.1) gives half the
- * energy of the full cube, with the plane along x and with the same plane
+ * symmetry or skew-symmetry mirror plane (docs/benchmarks.md D.1) gives half
+ * the energy of the full cube, with the plane along x and with the same plane
  * turned oblique.
  *
  * Tolerance: a rotation changes the order of the floating-point sums (cell

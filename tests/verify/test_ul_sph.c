@@ -217,7 +217,7 @@ typedef struct rings_result {
 
 /* A8 at 0.08 c0 with dp = 0.002 to `t_end`: initially adjacent pairs
  * (reference distance <= 1.5 dp, same body) and their largest current
- * distance in dp (BENCHMARKS E.5) */
+ * distance in dp (docs/benchmarks.md E.5) */
 static rings_result rings(const char *shear, double t_end) {
   char sh[64], te[64];
   snprintf(sh, sizeof sh, "method.shear=%s", shear);

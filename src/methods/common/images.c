@@ -1,5 +1,5 @@
 /* Mirror images across the scene's symmetry (normal component negated) and
- * skew-symmetry (tangential components negated) planes, as BENCHMARKS.md
+ * skew-symmetry (tangential components negated) planes, as docs/benchmarks.md
  * D.1 recommends for the swinging cube of seed 000 sec. 8.2: the image
  * particles of the reference configuration (built once, or for a run over
  * MPI ranks with a dynamic domain the serial run's, which ul-csph places at

@@ -388,7 +388,7 @@ static sph_status tl_jst_options_parse(sph_node *opt, tl_jst_options *o,
 /* The per-slot arrays of the chosen force and dissipation: eq. 31's
  * gradients of W~1 and reverse slots, the Laplacian weights
  * V_b Lap W~_b(X_a) of the JST term (corrected, or the Brookshaw form with
- * the corrected gradient of BENCHMARKS D.4). */
+ * the corrected gradient of docs/benchmarks.md D.4). */
 static sph_status setup_slots(tl_jst *m, sph_sim *sim, const sph_cloud *cloud,
                               int gradient_laplacian, int need_lap,
                               sph_error *err) {

@@ -1,7 +1,7 @@
 /* ul-csph over MPI ranks with symmetry and skew-symmetry planes (issue 20):
  * the serial run's mirror images are fixed at set-up (sph_mirror_table, seed
- * 000 sec. 8.2 / BENCHMARKS.md D.1), each carried by its source particle (its
- * serial number and reference position move with it), and at every rebuild
+ * 000 sec. 8.2 / docs/benchmarks.md D.1), each carried by its source particle
+ * (its serial number and reference position move with it), and at every rebuild
  * a rank places, between its owned particles and its ghosts, the images of
  * its owned particles and those within three supports of its owned box
  * (those within two first, whose lists are whole, so their corrections are

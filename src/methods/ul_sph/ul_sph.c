@@ -25,14 +25,14 @@
  * Bodies interact through the pressure terms only, and only in compression:
  * pairs of different bodies take no shear terms, and both their pressure
  * force and their continuity term act only while the pair's Riemann
- * pressure P* is positive (BENCHMARKS E.4), so colliding bodies bounce
+ * pressure P* is positive (docs/benchmarks.md E.4), so colliding bodies bounce
  * rather than stick, and a separating pair leaves no tension behind. The
  * continuity equation keeps the average normal velocity as U* unless
  * `continuity: riemann` asks for the pressure-difference term of eq. 13
- * (BENCHMARKS E.2). The stored energy reported is the volumetric energy of the
- * equation of state, sum m c0^2 (ln(rho/rho0) + rho0/rho - 1), plus the work
- * done against the shear forces (the ENOG force has no potential, BENCHMARKS
- * E.6), so the Riemann dissipation shows as a loss. */
+ * (docs/benchmarks.md E.2). The stored energy reported is the volumetric energy
+ * of the equation of state, sum m c0^2 (ln(rho/rho0) + rho0/rho - 1), plus the
+ * work done against the shear forces (the ENOG force has no potential,
+ * docs/benchmarks.md E.6), so the Riemann dissipation shows as a loss. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,6 +1,6 @@
 /* Pair interactions of ul-sph (seed 002): the low-dissipation Riemann
- * solver (eq. 13-16, limiter in the dimensionless form of BENCHMARKS E.1),
- * the Riemann continuity and pressure terms (eq. 11-12), the nested shear
+ * solver (eq. 13-16, limiter in the dimensionless form of docs/benchmarks.md
+ * E.1), the Riemann continuity and pressure terms (eq. 11-12), the nested shear
  * force (eq. 17), Gray et al.'s artificial stress force, the rotation-
  * invariant Laplacian of the velocity (eq. 23) and the velocity gradient
  * (eq. 18, or eq. 30 with the correction matrix B of eq. 31).
