@@ -143,8 +143,17 @@ START_TEST(oversized_and_deeply_nested_input_refused_fast) {
   /* a device or a huge file: refused once past 1 MiB, not read whole */
   sph_node *root = NULL;
   sph_error err;
-  ck_assert_int_eq(sph_node_load_file(&root, "/dev/zero", &err), SPH_ERR_RANGE);
+  ck_assert_int_eq(sph_node_load_file(&root, "/dev/zero", &err), SPH_ERR_IO);
+  ck_assert_ptr_nonnull(strstr(err.message, "not a regular file"));
+  /* a regular file of 3 MiB (sparse): refused by its size */
+  char big[] = "/tmp/sph_test_node_XXXXXX";
+  int fd = mkstemp(big);
+  ck_assert_int_ge(fd, 0);
+  ck_assert_int_eq(ftruncate(fd, 3 << 20), 0);
+  close(fd);
+  ck_assert_int_eq(sph_node_load_file(&root, big, &err), SPH_ERR_RANGE);
   ck_assert_ptr_nonnull(strstr(err.message, "not a scene"));
+  unlink(big);
   /* 320 kB of nested brackets: refused before the parser (which needs
    * seconds for it) at the first bracket too deep */
   size_t d = 160000, n = 2 * d + 16;
