@@ -432,9 +432,6 @@ typedef struct loaded {
   uint64_t calls[SPH_MAX_TIMERS + SPH_MAX_TERMS];
 } loaded;
 
-/* Checks one file against the simulation (and, for a piece of a run over
- * MPI ranks, against its manifest m); on success copies the state arrays
- * in and the rest into *out (the verdict over a copy of v). */
 /* The most bytes a checkpoint of this simulation can hold: the header,
  * verdict and call counts with room to spare, and the state arrays of the
  * most particles this rank can own. */
@@ -452,37 +449,51 @@ static size_t most_bytes(sph_sim *sim) {
   return bytes;
 }
 
-/* Checks one file against the simulation (and, for a piece of a run over
- * MPI ranks, against its manifest m); on success copies the state arrays
- * in and the rest into *out (the verdict over a copy of v). */
-static sph_status load(const char *path, const manifest *m, sph_sim *sim,
-                       const sph_verdict *v, loaded *out, sph_error *err) {
-  /* a regular file (a FIFO would hang); one larger than this simulation's
-   * checkpoint can be is not read whole: its header says why (another
-   * scene, method or particle count), else its size */
+/* A file read whole (or its first 4096 bytes when it is larger than a
+ * checkpoint of this simulation can be). */
+typedef struct raw {
+  unsigned char *buf;
+  size_t len, limit;
+  long long size;
+  int oversize;
+} raw;
+
+#define FAIL(...)                                                              \
+  return sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL, __VA_ARGS__)
+
+/* a regular file (a FIFO would hang); one larger than this simulation's
+ * checkpoint can be is not read whole: its header says why (another
+ * scene, method or particle count), else its size */
+static sph_status read_whole(const char *path, sph_sim *sim, raw *w,
+                             sph_error *err) {
   FILE *f;
-  long long size = 0;
-  SPH_TRY(sph_fopen_input(path, &f, &size, err));
-  size_t limit = most_bytes(sim);
-  int oversize = size < 0 || (unsigned long long)size > limit;
-  size_t len = oversize ? 4096 : (size_t)size;
-  unsigned char *buf = malloc(len ? len : 1);
-  if (!buf) {
+  w->size = 0;
+  SPH_TRY(sph_fopen_input(path, &f, &w->size, err));
+  w->limit = most_bytes(sim);
+  w->oversize = w->size < 0 || (unsigned long long)w->size > w->limit;
+  size_t len = w->oversize ? 4096 : (size_t)w->size;
+  w->buf = malloc(len ? len : 1);
+  if (!w->buf) {
     fclose(f);
     return sph_error_set(err, SPH_ERR_NOMEM, "checkpoint");
   }
-  size_t got = fread(buf, 1, len, f);
-  int bad_read = (!oversize && got != len) || ferror(f);
+  size_t got = fread(w->buf, 1, len, f);
+  int bad_read = (!w->oversize && got != len) || ferror(f);
   fclose(f);
-  len = got;
-  sph_status st = SPH_OK;
-#define FAIL(...)                                                              \
-  do {                                                                         \
-    st = sph_error_at(err, SPH_ERR_IO, path, 0, 0, NULL, __VA_ARGS__);         \
-    goto done;                                                                 \
-  } while (0)
-  if (bad_read)
+  w->len = got;
+  if (bad_read) {
+    free(w->buf);
     FAIL("cannot read (it changed while read)");
+  }
+  return SPH_OK;
+}
+
+/* the magic, the checksum and, for a piece, its manifest's size and sum */
+static sph_status check_bytes(const char *path, const manifest *m, const raw *w,
+                              sph_error *err) {
+  const unsigned char *buf = w->buf;
+  size_t len = w->len;
+  int oversize = w->oversize;
   if (len < 12 || memcmp(buf, magic, sizeof magic))
     FAIL("not an sph checkpoint");
   uint32_t sum;
@@ -495,12 +506,18 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
          "manifest: %llu bytes, %08lx): left by another checkpoint",
          len, (unsigned long)sum, (unsigned long long)m->mine.size,
          (unsigned long)m->mine.crc);
-  reader r = {buf, oversize ? len : len - 4, sizeof magic};
-  uint32_t version = 0, tag = 0, na = 0;
+  return SPH_OK;
+}
+
+/* version, byte order and the header, checked against the simulation (and
+ * the manifest m) before the file's size is */
+static sph_status read_header(reader *r, const char *path, const manifest *m,
+                              sph_sim *sim, const raw *w, header *hp,
+                              sph_error *err) {
+  uint32_t version = 0, tag = 0;
   header h;
-  memset(out, 0, sizeof *out);
   memset(&h, 0, sizeof h);
-  if (!get(&r, &version, 4) || !get(&r, &tag, 4))
+  if (!get(r, &version, 4) || !get(r, &tag, 4))
     FAIL("truncated header");
   if (version != SPH_CHECKPOINT_VERSION)
     FAIL("version %u, this sph reads version %u", version,
@@ -508,12 +525,11 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
   if (tag != endian_tag)
     FAIL("written on a machine of the other byte order");
   for (size_t i = 0; i < NHEADER; ++i)
-    if (!get(&r, (char *)&h + header_fields[i].off, header_fields[i].size))
+    if (!get(r, (char *)&h + header_fields[i].off, header_fields[i].size))
       FAIL("truncated header");
   h.method[sizeof h.method - 1] = h.scene[sizeof h.scene - 1] = '\0';
   unsigned crc = 0;
-  if ((st = sph_checkpoint_scene_crc(sim->scene, &crc, err)) != SPH_OK)
-    goto done;
+  SPH_TRY(sph_checkpoint_scene_crc(sim->scene, &crc, err));
   if (strcmp(h.scene, sim->scene->name))
     FAIL("written by scene '%s', not '%s'", h.scene, sim->scene->name);
   if (strcmp(h.method, sim->method->name))
@@ -532,63 +548,100 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
          "resolved settings differ; resume with the same scene and --set "
          "options)",
          h.scene);
-  if (oversize)
+  if (w->oversize)
     FAIL("%lld bytes, a checkpoint of this run holds at most %zu: damaged, "
          "or not its checkpoint",
-         size, limit);
+         w->size, w->limit);
   if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1)
     FAIL("time %g or output index %d out of range", h.t, h.next_output);
   if (m && (h.t != m->t || h.steps != m->step))
     FAIL("at step %llu, its manifest at step %llu", (unsigned long long)h.steps,
          m->step);
-  sph_verdict vv = *v;
+  *hp = h;
+  return SPH_OK;
+}
+
+/* the verdict (over the caller's copy in *vv) and the call counts */
+static sph_status read_verdict(reader *r, const char *path, const sph_sim *sim,
+                               sph_verdict *vv, uint64_t *calls,
+                               sph_error *err) {
   for (size_t i = 0; i < NVERDICT; ++i)
-    if (!get(&r, (char *)&vv + verdict_fields[i].off, verdict_fields[i].size))
+    if (!get(r, (char *)vv + verdict_fields[i].off, verdict_fields[i].size))
       FAIL("truncated verdict");
-  vv.reason[sizeof vv.reason - 1] = '\0';
+  vv->reason[sizeof vv->reason - 1] = '\0';
   uint32_t ncalls = 0;
-  uint64_t *calls = out->calls;
-  if (!get(&r, &ncalls, 4))
+  if (!get(r, &ncalls, 4))
     FAIL("truncated call counts");
   if (ncalls != (uint32_t)(sim->ntimers + sim->nterms))
     FAIL("holds %u call counts, the run has %d timers and terms", ncalls,
          sim->ntimers + sim->nterms);
-  if (!get(&r, calls, ncalls * sizeof *calls))
+  if (!get(r, calls, ncalls * sizeof *calls))
     FAIL("truncated call counts");
+  return SPH_OK;
+}
+
+/* the array table checked against the method's, then the state copied in
+ * and the domain told the piece's owned count */
+static sph_status read_state(reader *r, const char *path, sph_sim *sim,
+                             const header *h, sph_error *err) {
+  uint32_t na = 0;
   sph_state_array arr[SPH_MAX_STATE + 3];
   /* the arrays' lengths for the piece's owned count */
   size_t n_run = sim->ps->n;
-  sim->ps->n = (size_t)h.particles;
+  sim->ps->n = (size_t)h->particles;
   int nm = state_arrays(sim, sim->ps->n, 0, arr);
   sim->ps->n = n_run;
-  if (!get(&r, &na, 4) || na != (uint32_t)nm)
-    FAIL("holds %u state arrays, method %s has %d", na, h.method, nm);
+  if (!get(r, &na, 4) || na != (uint32_t)nm)
+    FAIL("holds %u state arrays, method %s has %d", na, h->method, nm);
   for (int i = 0; i < nm; ++i) {
     char name[16];
     uint64_t n;
-    if (!get(&r, name, sizeof name) || !get(&r, &n, 8))
+    if (!get(r, name, sizeof name) || !get(r, &n, 8))
       FAIL("truncated array table");
     name[sizeof name - 1] = '\0';
     if (strcmp(name, arr[i].name) || n != arr[i].len)
       FAIL("array %d is %s[%llu], expected %s[%zu]", i, name,
            (unsigned long long)n, arr[i].name, arr[i].len);
   }
-  size_t data_at = r.at, need = 0;
+  size_t data_at = r->at, need = 0;
   for (int i = 0; i < nm; ++i)
     need += arr[i].len * sizeof(double);
-  if (r.len - data_at != need)
-    FAIL("holds %zu bytes of state, expected %zu", r.len - data_at, need);
+  if (r->len - data_at != need)
+    FAIL("holds %zu bytes of state, expected %zu", r->len - data_at, need);
   /* everything checked: copy in */
   for (int i = 0; i < nm; ++i)
-    get(&r, arr[i].data, arr[i].len * sizeof(double));
+    get(r, arr[i].data, arr[i].len * sizeof(double));
   sph_error de;
-  if (sph_domain_resume(sim->domain, sim->ps, (size_t)h.particles, &de))
+  if (sph_domain_resume(sim->domain, sim->ps, (size_t)h->particles, &de))
     FAIL("%s", de.message);
-  out->h = h;
-  out->v = vv;
+  return SPH_OK;
+}
 #undef FAIL
-done:
-  free(buf);
+
+/* Checks one file against the simulation (and, for a piece of a run over
+ * MPI ranks, against its manifest m); on success copies the state arrays
+ * in and the rest into *out (the verdict over a copy of v). */
+static sph_status load(const char *path, const manifest *m, sph_sim *sim,
+                       const sph_verdict *v, loaded *out, sph_error *err) {
+  raw w;
+  SPH_TRY(read_whole(path, sim, &w, err));
+  sph_status st = check_bytes(path, m, &w, err);
+  header h;
+  sph_verdict vv = *v;
+  if (st == SPH_OK) {
+    reader r = {w.buf, w.oversize ? w.len : w.len - 4, sizeof magic};
+    memset(out, 0, sizeof *out);
+    st = read_header(&r, path, m, sim, &w, &h, err);
+    if (st == SPH_OK)
+      st = read_verdict(&r, path, sim, &vv, out->calls, err);
+    if (st == SPH_OK)
+      st = read_state(&r, path, sim, &h, err);
+  }
+  if (st == SPH_OK) {
+    out->h = h;
+    out->v = vv;
+  }
+  free(w.buf);
   return st;
 }
 

@@ -28,17 +28,9 @@ static void json_number(FILE *f, double x) {
     fputs("null", f);
 }
 
-sph_status sph_summary_write(const char *path, const sph_sim *sim,
-                             const sph_provenance *prov, const sph_verdict *v,
-                             const sph_reference_error *ref,
-                             double wall_seconds, const sph_sink *sinks,
-                             int nsinks, double mp4_seconds, int completed,
-                             const char *stopped_by, sph_error *err) {
-  sph_atomic_file af;
-  sph_status st = sph_atomic_open(&af, path, err);
-  if (st != SPH_OK)
-    return st;
-  FILE *f = af.f;
+/* the program, the scene and the method that ran */
+static void write_provenance(FILE *f, const sph_sim *sim,
+                             const sph_provenance *prov) {
   fputs("{\n  \"sph\": {\"version\": ", f);
   json_string(f, prov->version);
   fputs(", \"commit\": ", f);
@@ -53,6 +45,11 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_string(f, sim->method->title);
   fputs(", \"reference\": ", f);
   json_string(f, sim->method->reference);
+}
+
+/* each part's seconds and calls, each sink's seconds and its thread's */
+static void write_timers(FILE *f, const sph_sim *sim, const sph_sink *sinks,
+                         int nsinks, double mp4_seconds) {
   fputs("},\n  \"terms\": {", f);
   int first = 1;
   for (int i = 0; i < sim->ntimers; ++i) {
@@ -96,6 +93,10 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     thread_seconds += sinks[i].thread_seconds;
   fputs("},\n  \"render_thread_seconds\": ", f);
   json_number(f, thread_seconds);
+}
+
+/* the run's size: particles, steps, ranks, the halo's moves, time steps */
+static void write_run_size(FILE *f, const sph_sim *sim, double wall_seconds) {
   fprintf(f, ",\n  \"particles\": %zu,\n  \"steps\": %lu,\n",
           sph_domain_particles(sim->domain, sim->ps), sim->steps);
   if (sim->domain) /* a run over MPI ranks; the timers are rank 0's */
@@ -114,6 +115,10 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_number(f, sim->steps ? sim->dt_min : NAN);
   fputs(",\n  \"dt_max\": ", f);
   json_number(f, sim->steps ? sim->dt_max : NAN);
+}
+
+/* energy, momentum drifts, J, checkerboard, fracture and zigzag */
+static void write_conservation(FILE *f, const sph_verdict *v) {
   fputs(",\n  \"energy\": {\"initial\": ", f);
   json_number(f, v->energy0);
   fputs(", \"final\": ", f);
@@ -137,6 +142,10 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   json_number(f, v->zigzag_max);
   /* particles R is judged on (0: every body too coarse to judge) */
   fprintf(f, ",\n  \"zigzag_judged_particles\": %zu", v->zigzag_count);
+}
+
+/* the verdict and when each indicator tripped */
+static void write_verdict(FILE *f, const sph_verdict *v) {
   fprintf(f, ",\n  \"nan\": %s,\n  \"stable\": %s,\n  \"reason\": ",
           v->nan ? "true" : "false", v->stable ? "true" : "false");
   json_string(f, v->reason);
@@ -156,31 +165,38 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
     json_number(f, v->tripped_at[i]);
   }
   fputc('}', f);
-  if (ref) {
-    sph_reference_error e = *ref;
-    /* the quantities this reference gives */
-    const struct {
-      const char *key;
-      double x;
-    } q[] = {{"l2_velocity", e.l2_velocity},
-             {"l2_stress", e.l2_stress},
-             {"l2_displacement", e.l2_displacement},
-             {"h1_displacement", e.h1_displacement},
-             {"period", e.period},
-             {"period_reference", e.period_value},
-             {"period_error", e.period_error},
-             {"period_tolerance", e.period_tolerance}};
-    const char *sep = ",\n  \"error\": {";
-    size_t k0 = e.period_value > 0.0 ? 4 : 0, k1 = k0 ? 8 : 4;
-    for (size_t k = k0; k < k1; ++k) {
-      if (k == 7 && isnan(q[k].x)) /* no tolerance given */
-        continue;
-      fprintf(f, "%s\"%s\": ", sep, q[k].key);
-      json_number(f, q[k].x);
-      sep = ", ";
-    }
-    fputs("}", f);
+}
+
+/* the errors against the scene's reference solution */
+static void write_reference_error(FILE *f, const sph_reference_error *ref) {
+  sph_reference_error e = *ref;
+  /* the quantities this reference gives */
+  const struct {
+    const char *key;
+    double x;
+  } q[] = {{"l2_velocity", e.l2_velocity},
+           {"l2_stress", e.l2_stress},
+           {"l2_displacement", e.l2_displacement},
+           {"h1_displacement", e.h1_displacement},
+           {"period", e.period},
+           {"period_reference", e.period_value},
+           {"period_error", e.period_error},
+           {"period_tolerance", e.period_tolerance}};
+  const char *sep = ",\n  \"error\": {";
+  size_t k0 = e.period_value > 0.0 ? 4 : 0, k1 = k0 ? 8 : 4;
+  for (size_t k = k0; k < k1; ++k) {
+    if (k == 7 && isnan(q[k].x)) /* no tolerance given */
+      continue;
+    fprintf(f, "%s\"%s\": ", sep, q[k].key);
+    json_number(f, q[k].x);
+    sep = ", ";
   }
+  fputs("}", f);
+}
+
+/* how far the run went and what stopped it */
+static void write_end(FILE *f, const sph_sim *sim, int completed,
+                      const char *stopped_by) {
   fprintf(f, ",\n  \"threads\": %d,\n  \"t_end\": ", sim->threads);
   json_number(f, sim->scene->t_end);
   fputs(",\n  \"t_reached\": ", f);
@@ -192,6 +208,27 @@ sph_status sph_summary_write(const char *path, const sph_sim *sim,
   else
     fputs("null", f);
   fputs("\n}\n", f);
+}
+
+sph_status sph_summary_write(const char *path, const sph_sim *sim,
+                             const sph_provenance *prov, const sph_verdict *v,
+                             const sph_reference_error *ref,
+                             double wall_seconds, const sph_sink *sinks,
+                             int nsinks, double mp4_seconds, int completed,
+                             const char *stopped_by, sph_error *err) {
+  sph_atomic_file af;
+  sph_status st = sph_atomic_open(&af, path, err);
+  if (st != SPH_OK)
+    return st;
+  FILE *f = af.f;
+  write_provenance(f, sim, prov);
+  write_timers(f, sim, sinks, nsinks, mp4_seconds);
+  write_run_size(f, sim, wall_seconds);
+  write_conservation(f, v);
+  write_verdict(f, v);
+  if (ref)
+    write_reference_error(f, ref);
+  write_end(f, sim, completed, stopped_by);
   st = sph_atomic_commit(&af, err);
   if (st != SPH_OK)
     sph_atomic_abort(&af);
