@@ -327,15 +327,21 @@ static void run_stop(sph_run *run, int value) {
                                    &run->err);
 }
 
-/* the loop over output times to t_stop or for max_steps steps */
-static sph_status run_loop(sph_run *run, double t_stop, unsigned long max_steps,
-                           sph_error *err) {
+/* a started, open run with its first output frame written */
+static sph_status run_ready(sph_run *run, sph_error *err) {
   if (!run->started || run->closed)
     return sph_error_set(err, SPH_ERR_ARG,
                          run->closed ? "the run is closed"
                                      : "the run was not started");
   if (!run->begun)
     run_begin(run);
+  return SPH_OK;
+}
+
+/* the loop over output times to t_stop or for max_steps steps */
+static sph_status run_loop(sph_run *run, double t_stop, unsigned long max_steps,
+                           sph_error *err) {
+  SPH_TRY(run_ready(run, err));
   sph_sim *sim = run->sim;
   double eps = run_eps(run), t_end = run->scene->t_end;
   if (run_going(run)) {
@@ -491,12 +497,7 @@ static void summary_fill(const sph_run *run, sph_summary *out) {
 }
 
 sph_status sph_run_close(sph_run *run, sph_summary *summary, sph_error *err) {
-  if (!run->started || run->closed)
-    return sph_error_set(err, SPH_ERR_ARG,
-                         run->closed ? "the run is closed"
-                                     : "the run was not started");
-  if (!run->begun)
-    run_begin(run);
+  SPH_TRY(run_ready(run, err));
   sph_sim *sim = run->sim;
   const sph_scene *s = run->scene;
   /* closed before its end: as if stopped */
