@@ -16,6 +16,10 @@
 #define SPH_SCENE_MAX_BYTES (1 << 20)
 #define MAX_DEPTH 64
 #define MAX_NODES 1000000
+/* bytes the copies made through aliases may take (scalars, paths and a
+ * node's own size): a billion-laughs scene of 100 kB took 1.1 GB (issue 36) */
+#define MAX_ALIAS_BYTES (16 << 20)
+#define NODE_BYTES 96
 #define CMDLINE "<command line>"
 
 /* ---- loading ---- */
@@ -25,6 +29,9 @@ typedef struct loader {
   const char *file;
   size_t nodes;
   yaml_node_t *open[MAX_DEPTH + 1]; /* the nodes being converted */
+  unsigned char *seen;       /* per document node: converted once already */
+  size_t alias_bytes;        /* what the copies through aliases took */
+  int alias_line, alias_col; /* the outermost alias being copied (0: none) */
   sph_error *err;
 } loader;
 
@@ -37,7 +44,7 @@ static sph_status add_child(loader *L, sph_node *parent, const char *key,
   char *path = key ? sph_node_join_key(parent->path, key)
                    : sph_node_join_index(parent->path, parent->count);
   if (!path)
-    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "no memory for the scene tree");
   sph_node *child;
   sph_status st = convert(L, y, path, line, col, depth, &child);
   free(path);
@@ -45,7 +52,7 @@ static sph_status add_child(loader *L, sph_node *parent, const char *key,
     return st;
   if (sph_node_append(parent, key, child)) {
     sph_node_destroy(child);
-    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "no memory for the scene tree");
   }
   return SPH_OK;
 }
@@ -96,6 +103,25 @@ static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
   if (++L->nodes > MAX_NODES)
     return sph_error_at(L->err, SPH_ERR_RANGE, L->file, line, col, path,
                         "more than %d nodes (aliases expanding?)", MAX_NODES);
+  /* a node met again is a copy through an alias: bound the bytes copied */
+  size_t id = (size_t)(y - L->doc->nodes.start);
+  int outer = 0;
+  if (L->seen[id] && !L->alias_line) {
+    outer = 1;
+    L->alias_line = line;
+    L->alias_col = col;
+  }
+  if (L->alias_line) {
+    L->alias_bytes += NODE_BYTES + strlen(path) +
+                      (y->type == YAML_SCALAR_NODE ? y->data.scalar.length : 0);
+    if (L->alias_bytes > MAX_ALIAS_BYTES)
+      return sph_error_at(L->err, SPH_ERR_RANGE, L->file, L->alias_line,
+                          L->alias_col, NULL,
+                          "aliases expand the scene past %d MB (the alias "
+                          "here and those it contains): copy less",
+                          MAX_ALIAS_BYTES >> 20);
+  }
+  L->seen[id] = 1;
   sph_node_kind kind = y->type == YAML_MAPPING_NODE    ? SPH_NODE_MAP
                        : y->type == YAML_SEQUENCE_NODE ? SPH_NODE_SEQ
                                                        : SPH_NODE_SCALAR;
@@ -104,7 +130,7 @@ static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
   if (!n || !p) {
     free(p);
     sph_node_destroy(n);
-    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "no memory for the scene tree");
   }
   free(n->path);
   n->path = p;
@@ -113,7 +139,8 @@ static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
     size_t len = y->data.scalar.length;
     if (!(n->value = malloc(len + 1))) {
       sph_node_destroy(n);
-      return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+      return sph_error_set(L->err, SPH_ERR_NOMEM,
+                           "no memory for the scene tree");
     }
     memcpy(n->value, y->data.scalar.value, len);
     n->value[len] = '\0';
@@ -134,6 +161,8 @@ static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
     st = sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, line, col, path,
                       "empty node");
   }
+  if (outer)
+    L->alias_line = L->alias_col = 0;
   if (st != SPH_OK) {
     sph_node_destroy(n);
     return st;
@@ -146,7 +175,7 @@ static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
 static sph_status parse_error(const yaml_parser_t *p, const char *text,
                               size_t len, const char *origin, sph_error *err) {
   if (p->error == YAML_MEMORY_ERROR)
-    return sph_error_set(err, SPH_ERR_NOMEM, "YAML parser");
+    return sph_error_set(err, SPH_ERR_NOMEM, "no memory for the YAML parser");
   const char *problem = p->problem ? p->problem : "malformed document";
   if (p->error == YAML_READER_ERROR) {
     /* reader errors carry a byte offset: count lines and characters */
@@ -214,7 +243,7 @@ sph_status sph_node_load_text(const char *text, size_t len, const char *origin,
   SPH_TRY(flow_depth(text, len, origin, err));
   yaml_parser_t parser;
   if (!yaml_parser_initialize(&parser))
-    return sph_error_set(err, SPH_ERR_NOMEM, "YAML parser");
+    return sph_error_set(err, SPH_ERR_NOMEM, "no memory for the YAML parser");
   yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
   yaml_document_t doc;
   if (!yaml_parser_load(&parser, &doc)) {
@@ -229,14 +258,19 @@ sph_status sph_node_load_text(const char *text, size_t len, const char *origin,
   sph_status st = SPH_OK;
   if (empty && allow_empty) {
     if (!(*root = sph_node_scalar_new("", origin, 1, 1)))
-      st = sph_error_set(err, SPH_ERR_NOMEM, "scene tree");
+      st = sph_error_set(err, SPH_ERR_NOMEM, "no memory for the scene tree");
   } else if (empty) {
     st = sph_error_at(err, SPH_ERR_SYNTAX, origin, 1, 1, NULL,
                       "the document is empty");
   } else {
     loader L = {.doc = &doc, .file = origin, .err = err};
-    st = convert(&L, top, "", (int)top->start_mark.line + 1,
-                 (int)top->start_mark.column + 1, 0, root);
+    L.seen = calloc((size_t)(doc.nodes.top - doc.nodes.start) + 1, 1);
+    st = L.seen ? convert(&L, top, "", (int)top->start_mark.line + 1,
+                          (int)top->start_mark.column + 1, 0, root)
+                : sph_error_set(err, SPH_ERR_NOMEM,
+                                "no memory for the scene "
+                                "tree");
+    free(L.seen);
   }
   yaml_document_delete(&doc);
 
