@@ -6,6 +6,13 @@
 #ifndef SPH_PNG_SCHEMA_H
 #define SPH_PNG_SCHEMA_H
 
+/* Bytes a frame's pixel takes while drawn (the memory estimate, sim.c):
+ * the GL colour (RGBA8) and depth (32F) renderbuffers, the read-back and
+ * the image (RGBA8 each); over MPI ranks, the tag attachment (RGBA32UI), its
+ * read-back and rank 0's composite (16 bytes each, render/gl.c, png_sink.c). */
+#define SPH_PNG_BYTES_PER_PIXEL 16
+#define SPH_PNG_TAG_BYTES_PER_PIXEL 48
+
 #include "scene/node.h"
 #include "sph/status.h"
 

@@ -125,9 +125,9 @@ static int run_open(const sph_app_args *args, const char *path,
     (*scene)->memory_limit = args->max_memory;
     st = sph_run_open(run, *scene, &opt, &hooks, &err);
   }
-  if (st != SPH_OK) {
+  if (st != SPH_OK) { /* out of memory: 3, as a run's (issue 36) */
     sph_app_print_error(&err);
-    return SPH_EXIT_USAGE;
+    return st == SPH_ERR_NOMEM ? SPH_EXIT_IO : SPH_EXIT_USAGE;
   }
   if (args->resume && args->out && strcmp(args->resume, args->out)) {
     fprintf(stderr, "sph: --resume continues in its own folder; drop --out "

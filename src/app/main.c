@@ -231,11 +231,12 @@ int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
                  sph_sim **sim) {
   sph_error err;
   sph_error_clear(&err);
-  if (sph_app_check_scene(path, args->sets, args->nsets, args->max_memory,
-                          scene, sim, &err) == SPH_OK)
+  sph_status st = sph_app_check_scene(path, args->sets, args->nsets,
+                                      args->max_memory, scene, sim, &err);
+  if (st == SPH_OK)
     return SPH_EXIT_OK;
   sph_app_print_error(&err);
-  return SPH_EXIT_USAGE;
+  return st == SPH_ERR_NOMEM ? SPH_EXIT_IO : SPH_EXIT_USAGE;
 }
 
 /* libgomp reads its wait policy once, when it is loaded, before main: a

@@ -7,6 +7,7 @@
 #include "core/tensor.h"
 #include "parallel/domain.h"
 #include "scene/geometry.h"
+#include "solver/memory.h"
 #include "solver/reference.h"
 
 #include <math.h>
@@ -71,9 +72,12 @@ static sph_status check_output_fields(const sph_sim *sim, sph_error *err) {
 }
 
 /* Refuses, before anything is allocated, a run that would not fit in the
- * memory available (or the scene's memory_limit, when lower): particles bounded
- * from the bodies' lattices, each with about 1 kB of fields and 24 bytes per
- * neighbour slot (tl-jst measured 2.6 to 2.7 kB per particle in 3D, sph bench).
+ * memory it may take (solver/memory.h: --max-memory, the memory available,
+ * the memory cgroup, ulimit -v): particles bounded from the bodies' lattices,
+ * each with about 1 kB of fields and 24 bytes per neighbour slot (tl-jst
+ * measured 2.6 to 2.7 kB per particle in 3D, sph bench), and the png sink's
+ * frame buffers (SPH_PNG_BYTES_PER_PIXEL a frame, and over ranks each rank's
+ * tag attachment, SPH_PNG_TAG_BYTES_PER_PIXEL).
  */
 static sph_status check_memory(const sph_scene *scene, double support,
                                double dp, sph_error *err) {
@@ -93,36 +97,39 @@ static sph_status check_memory(const sph_scene *scene, double support,
   /* over ranks: the share of the ranks on this node */
   int ranks = sph_domain_world_size(), here = sph_domain_node_size();
   double need = n * (1000.0 + 24.0 * nb) * here / ranks;
-  double avail = 0.0;
-  FILE *f = fopen("/proc/meminfo", "r");
-  char line[128];
-  while (f && fgets(line, sizeof line, f))
-    if (sscanf(line, "MemAvailable: %lf kB", &avail) == 1) {
-      avail *= 1024.0;
-      break;
-    }
-  if (f)
-    fclose(f);
-  double limit = scene->memory_limit;
-  int by_limit = limit > 0.0 && !(avail > 0.0 && 0.9 * avail < limit);
-  if (by_limit ? need <= limit : !(avail > 0.0) || need <= 0.9 * avail)
+  double frame = 0.0;
+  if (scene->output.png.enabled) {
+    double px =
+        (double)scene->output.png.width * (double)scene->output.png.height;
+    frame = px * SPH_PNG_BYTES_PER_PIXEL;
+    if (ranks > 1)
+      frame =
+          here * px * (SPH_PNG_BYTES_PER_PIXEL + SPH_PNG_TAG_BYTES_PER_PIXEL);
+  }
+  sph_memory_limit lim;
+  sph_memory_limit_get(scene->memory_limit, &lim);
+  if (!(lim.bytes > 0.0) || need + frame <= lim.bytes)
     return SPH_OK;
   const sph_node *bodies = sph_node_child(scene->root, "bodies");
+  const sph_node *at = bodies ? bodies : scene->root;
   char share[96] = "";
   if (ranks > 1)
     snprintf(share, sizeof share, " (%d of the %d ranks on this node)", here,
              ranks);
-  if (by_limit)
-    return sph_node_error(bodies ? bodies : scene->root, err, SPH_ERR_RANGE,
-                          "about %.3g particles need about %.3g GB%s; the "
-                          "limit (--max-memory) is %.3g GB: fewer particles "
-                          "(a larger spacing or count)",
-                          n, need / 1e9, share, limit / 1e9);
-  return sph_node_error(
-      bodies ? bodies : scene->root, err, SPH_ERR_RANGE,
-      "about %.3g particles need about %.1f GB%s; %.1f GB of memory is "
-      "available: fewer particles (a larger spacing or count)",
-      n, need / 1e9, share, avail / 1e9);
+  if (frame > 0.0 && (frame > need || frame > lim.bytes)) {
+    const sph_node *out = sph_node_child(scene->root, "output");
+    const sph_node *png = out ? sph_node_child(out, "png") : NULL;
+    return sph_node_error(
+        png ? png : at, err, SPH_ERR_RANGE,
+        "the %d x %d frames need about %.3g GB%s and the particles about "
+        "%.3g GB; %s: smaller frames (png.width, png.height)",
+        scene->output.png.width, scene->output.png.height, frame / 1e9, share,
+        need / 1e9, lim.what);
+  }
+  return sph_node_error(at, err, SPH_ERR_RANGE,
+                        "about %.3g particles need about %.3g GB%s; %s: fewer "
+                        "particles (a larger spacing or count)",
+                        n, (need + frame) / 1e9, share, lim.what);
 }
 
 /* A distributed run (more than one MPI rank) of what runs distributed so
