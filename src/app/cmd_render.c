@@ -17,6 +17,7 @@
 #include "io/vtk_read.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "solver/sim.h"
 
 static const char *const render_usage =
     "usage: sph render RUN_DIR|RUN_DIR/<scene>.pvd [--field F] "
@@ -337,6 +338,8 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
   st = sph_scene_load(&j.scene, scene_path, a->sets, a->nsets, err);
   if (st == SPH_OK && !j.scene->output.png.enabled)
     st = sph_error_set(err, SPH_ERR_ARG, "output.png is off");
+  if (st == SPH_OK) /* the particles and frames fit, as sph run checks */
+    st = sph_sim_check_memory(j.scene, err);
   if (st == SPH_OK)
     st = sph_pvd_read(pvd, &j.pvd, err);
   if (st == SPH_OK)

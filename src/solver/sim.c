@@ -268,6 +268,14 @@ static sph_status check_state(sph_sim *sim, int setup, sph_error *err) {
   return SPH_OK;
 }
 
+sph_status sph_sim_check_memory(const sph_scene *scene, sph_error *err) {
+  double dp = sph_scene_min_spacing(scene);
+  sph_kernel kernel;
+  SPH_TRY(sph_kernel_create(&kernel, scene->kernel_type, scene->dimension,
+                            scene->h_over_dp * dp, err));
+  return check_memory(scene, kernel.support, dp, err);
+}
+
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
                           sph_error *err) {
   *out = NULL;

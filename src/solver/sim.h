@@ -147,6 +147,11 @@ void sph_method_known(char *known, size_t size);
  * ("did you mean"), else the names known. */
 sph_status sph_method_unknown(const char *name, sph_node *at, sph_error *err);
 
+/* The memory estimate of sph_sim_create alone (the scene's particles and
+ * frames against the limits of solver/memory.h): SPH_ERR_RANGE at the
+ * scene's bodies or png block when it does not fit. sph render uses it. */
+sph_status sph_sim_check_memory(const sph_scene *scene, sph_error *err);
+
 /* Builds particles, looks up and sets up the method (its option errors point
  * into the scene file). */
 sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,

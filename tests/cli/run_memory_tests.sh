@@ -39,6 +39,13 @@ SPH_CGROUP_ROOT="$work/cg2" "$sph" check "$col" >/dev/null 2>"$work/stderr" && o
 [ $? -eq 2 ] && grep -qF "output.png: the 16384 x 16384 frames need about 4.29 GB" "$work/stderr" && ok ||
   bad "16384^2 frames: $(cat "$work/stderr")"
 
+# (d) sph render applies the estimate to scene_used.yaml's particles
+"$sph" run punch --set time.end=0.00002 --set output.every=0.00001 --out "$work/r" --quiet >/dev/null 2>&1
+echo 1000000 >"$work/cg2/memory.max"
+SPH_CGROUP_ROOT="$work/cg2" "$sph" render "$work/r" --out "$work/r/again" >/dev/null 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "the memory cgroup's limit of 1 MB" "$work/stderr" && [ ! -e "$work/r/again" ] && ok ||
+  bad "render under a 1 MB cgroup: $(cat "$work/stderr")"
+
 # (f) out of memory while loading: exit 3 naming what, never 2 "scene tree";
 # a scene copied through aliases, under a small ulimit -v
 head -22 "$src/tests/cli/bad/alias_bomb.yaml" | tail -n +2 >"$work/laughs.yaml"
