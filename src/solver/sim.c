@@ -74,10 +74,15 @@ static sph_status check_output_fields(const sph_sim *sim, sph_error *err) {
 /* Refuses, before anything is allocated, a run that would not fit in the
  * memory it may take (solver/memory.h: --max-memory, the memory available,
  * the memory cgroup, ulimit -v): particles bounded from the bodies' lattices,
- * each with about 1 kB of fields and 24 bytes per neighbour slot (tl-jst
- * measured 2.6 to 2.7 kB per particle in 3D, sph bench), and the png sink's
- * frame buffers (SPH_PNG_BYTES_PER_PIXEL a frame, and over ranks each rank's
- * tag attachment, SPH_PNG_TAG_BYTES_PER_PIXEL).
+ * each with about 1.8 kB of fields and buffers and 24 bytes per neighbour
+ * slot, and the png sink's frame buffers (SPH_PNG_BYTES_PER_PIXEL a frame,
+ * and over ranks each rank's tag attachment, SPH_PNG_TAG_BYTES_PER_PIXEL).
+ * The per-particle figures are an upper bound fitted to the growth of peak
+ * RSS (/usr/bin/time, one thread, two frames) with the particle count:
+ * twisting_column (tl-jst 3D, 1.8k/20k/100k particles) 3.40 kB, colliding_rings
+ * (ul-sph 2D, 4.4k/17.6k) 2.12 kB, punch (3D, 0.7k/18.7k) 1.82 kB; the
+ * former 1 kB + 24 nb gave 2.77 and 1.51 kB, low by 25 and 40 %
+ * (tests/cli/run_memory_tests.sh holds the estimate above the peak).
  */
 static sph_status check_memory(const sph_scene *scene, double support,
                                double dp, sph_error *err) {
@@ -96,7 +101,7 @@ static sph_status check_memory(const sph_scene *scene, double support,
   double r = support / dp, nb = dim == 3 ? 4.19 * r * r * r : 3.14 * r * r;
   /* over ranks: the share of the ranks on this node */
   int ranks = sph_domain_world_size(), here = sph_domain_node_size();
-  double need = n * (1000.0 + 24.0 * nb) * here / ranks;
+  double need = n * (1800.0 + 24.0 * nb) * here / ranks;
   double frame = 0.0;
   if (scene->output.png.enabled) {
     double px =

@@ -61,5 +61,29 @@ for v in 200000 210000 220000 230000 240000 260000 280000 300000; do
 done
 [ $seen -eq 1 ] && ok || bad "no out-of-memory exit 3 seen while loading"
 
+# (b) the estimate bounds the peak resident set's growth with the particles
+peak() { # peak RSS in kB of a two-frame run of scene $1 with --set $2 $3
+  rm -rf "$work/p"
+  /usr/bin/time -f %M -o "$work/rss" "$sph" run "$1" --set "$2" --set "$3" \
+    --set output.every=0.000001 --set time.end=0.000002 --threads 1 --quiet --out "$work/p" >/dev/null 2>&1
+  tail -1 "$work/rss"
+}
+grows() { # name scene small large (--set assignments of the particles)
+  local a b g
+  a=$(peak "$2" "$3" "$4")
+  b=$(peak "$2" "$5" "$6")
+  g=$((b - a))
+  # the larger scene's estimate is above the growth: --max-memory refuses it
+  "$sph" check "$2" --set "$5" --set "$6" --set output.every=0.000001 --set time.end=0.000002 --max-memory $((g > 1024 ? g : 1024))k >/dev/null 2>"$work/stderr"
+  [ $? -eq 2 ] && grep -qF "the limit (--max-memory)" "$work/stderr" && ok ||
+    bad "$1: peak grew ${g} kB, more than the estimate: $(cat "$work/stderr")"
+}
+if [ -x /usr/bin/time ]; then
+  grows twisting_column "$col" 'bodies.0.particles.count=[7,37,7]' 'time.end=0.000002' \
+    'bodies.0.particles.count=[13,67,13]' 'time.end=0.000002'
+  grows colliding_rings colliding_rings 'bodies.0.particles.spacing=0.001' 'bodies.1.particles.spacing=0.001' \
+    'bodies.0.particles.spacing=0.0006' 'bodies.1.particles.spacing=0.0006'
+fi
+
 echo "memory: $pass passed, $fail failed"
 [ $fail -eq 0 ]
