@@ -7,11 +7,25 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "app/app_impl.h"
 #include "app/progress_impl.h"
 #include "scene/scene.h"
 #include "solver/run.h"
+
+/* More ranks x threads on this node than cores: each waits for the
+ * others' turns (issue 36); said, as the run may be many times slower. */
+static void oversubscribed_note(const sph_sim *sim) {
+  long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  int ranks = sph_domain_node_ranks();
+  if (!sim->domain || cores <= 0 || (long)ranks * sim->threads <= cores)
+    return;
+  printf("  note       %d rank%s x %d thread%s on %ld core%s: oversubscribed "
+         "(docs/mpi.md)\n",
+         ranks, ranks == 1 ? "" : "s", sim->threads,
+         sim->threads == 1 ? "" : "s", cores, cores == 1 ? "" : "s");
+}
 
 static void banner(const sph_sim *sim, const char *dir, const sph_halo *h) {
   const sph_scene *s = sim->scene;
@@ -35,6 +49,7 @@ static void banner(const sph_sim *sim, const char *dir, const sph_halo *h) {
            "in %.0f messages per exchange\n",
            sph_domain_size(sim->domain), h->max_owned, h->max_ghosts, h->values,
            h->messages);
+  oversubscribed_note(sim);
   printf("  output     %s/\n", dir);
   fflush(stdout);
 }

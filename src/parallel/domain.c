@@ -20,7 +20,7 @@
 #include <mpi.h>
 #endif
 
-static int world_rank = 0, world_size = 1;
+static int world_rank = 0, world_size = 1, node_ranks = 1;
 #ifdef SPH_HAVE_MPI
 static int mpi_started = 0;
 #endif
@@ -36,11 +36,23 @@ static int launched_size(void) {
   return getenv("PMIX_RANK") ? 2 : 0;
 }
 
+/* OpenMPI busy-polls while a rank waits: beside other work on a shared
+ * machine a waiting rank takes the core its partner needs (issue 36: 2 ranks
+ * 7-10x slower than one). Unless the user chose (OMPI_MCA_mpi_yield_when_idle,
+ * or mpirun --mca, which sets it), waits yield; OpenMPI reads it in MPI_Init.
+ * Returns 1 when it set the default. */
+int sph_domain_idle_defaults(void) {
+  if (getenv("OMPI_MCA_mpi_yield_when_idle"))
+    return 0;
+  return setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0) == 0;
+}
+
 sph_status sph_domain_init(int *argc, char ***argv, sph_error *err) {
   int launched = launched_size();
 #ifdef SPH_HAVE_MPI
   if (launched <= 0)
     return SPH_OK; /* serial: MPI is never started */
+  sph_domain_idle_defaults();
   int provided;
   if (MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided) !=
       MPI_SUCCESS)
@@ -48,6 +60,7 @@ sph_status sph_domain_init(int *argc, char ***argv, sph_error *err) {
   mpi_started = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+  node_ranks = sph_domain_node_size();
   return SPH_OK;
 #else
   (void)argc, (void)argv;
@@ -71,6 +84,7 @@ void sph_domain_finalize(void) {
 
 int sph_domain_world_rank(void) { return world_rank; }
 int sph_domain_world_size(void) { return world_size; }
+int sph_domain_node_ranks(void) { return node_ranks; }
 
 int sph_domain_rank(const sph_domain *d) { return d ? d->rank : 0; }
 double sph_domain_seconds(const sph_domain *d) { return d ? d->seconds : 0.0; }

@@ -56,6 +56,11 @@ sph_status sph_domain_world_agree(sph_status st, sph_error *err);
 sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err);
 /* The ranks on this rank's node (sharing its memory; 1 without MPI). */
 int sph_domain_node_size(void);
+/* The same, counted once by sph_domain_init (no communication). */
+int sph_domain_node_ranks(void);
+/* Before MPI starts: sets OMPI_MCA_mpi_yield_when_idle=1 unless it is set
+ * (waiting ranks yield the core); 1 when it set it. */
+int sph_domain_idle_defaults(void);
 
 /* sph_domain_create for a run with mirror images: the ghosts are also the
  * particles within two supports of the owned ones or of their reflections

@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #ifdef SPH_HAVE_MPI
 #include <mpi.h>
@@ -23,6 +24,48 @@ static void place_rows(double *out, const int64_t *key, const double *rows,
 
 #ifdef SPH_HAVE_MPI
 
+/* OpenMPI's blocking calls poll: on a shared machine a waiting rank takes
+ * the core its partner (or other work) needs, and 2 ranks ran 7-10x slower
+ * than one (issue 36). The per-step waits poll for about 50 us, then sleep
+ * 50 us between polls: a sleeping rank leaves its core. */
+int sph_domain_wait(int n, void *req) {
+  static int spin = -1;
+  if (spin < 0) {
+    const char *w = getenv("SPH_MPI_WAIT");
+    spin = w && strcmp(w, "spin") == 0;
+  }
+  const struct timespec nap = {0, 50000};
+  double t0 = -1.0;
+  for (;;) {
+    int done = 0,
+        rc = MPI_Testall(n, (MPI_Request *)req, &done, MPI_STATUSES_IGNORE);
+    if (rc != MPI_SUCCESS || done)
+      return rc;
+    if (spin)
+      continue;
+    double t = MPI_Wtime();
+    if (t0 < 0.0)
+      t0 = t;
+    else if (t - t0 > 50e-6)
+      nanosleep(&nap, NULL);
+  }
+}
+
+/* MPI_Allreduce and MPI_Allgather with that wait (for MIN, MAX and
+ * gathers: the same values as the blocking calls) */
+static void allreduce(const void *in, void *out, int n, MPI_Datatype type,
+                      MPI_Op op) {
+  MPI_Request r;
+  MPI_Iallreduce(in, out, n, type, op, MPI_COMM_WORLD, &r);
+  sph_domain_wait(1, &r);
+}
+
+static void allgather(const void *in, int n, MPI_Datatype type, void *out) {
+  MPI_Request r;
+  MPI_Iallgather(in, n, type, out, n, type, MPI_COMM_WORLD, &r);
+  sph_domain_wait(1, &r);
+}
+
 sph_status sph_domain_world_agree(sph_status st, sph_error *err) {
   return sph_domain_world_first(st, INT64_MAX, err);
 }
@@ -35,10 +78,10 @@ sph_status sph_domain_world_first(sph_status st, int64_t key, sph_error *err) {
                      st != SPH_OK ? sph_domain_world_rank()
                                   : sph_domain_world_size()},
           low[2];
-  MPI_Allreduce(mine, low, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+  allreduce(mine, low, 1, MPI_INT64_T, MPI_MIN);
   if (mine[0] != low[0])
     mine[1] = sph_domain_world_size();
-  MPI_Allreduce(mine + 1, low + 1, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+  allreduce(mine + 1, low + 1, 1, MPI_INT64_T, MPI_MIN);
   if (low[1] == sph_domain_world_size())
     return SPH_OK;
   sph_error e;
@@ -88,7 +131,7 @@ sph_status sph_domain_exchange(sph_domain *d, double *field, int ncomp,
       d->sent += (double)(ncomp * d->send_count[q]);
       d->messages += 1.0;
     }
-  int rc = MPI_Waitall(nr, req, MPI_STATUSES_IGNORE);
+  int rc = sph_domain_wait(nr, req);
   d->seconds += MPI_Wtime() - t0;
   if (rc != MPI_SUCCESS)
     return sph_error_set(err, SPH_ERR_IO, "halo exchange failed");
@@ -100,7 +143,7 @@ double sph_domain_min(sph_domain *d, double v) {
   if (!d)
     return out;
   double t0 = MPI_Wtime();
-  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN);
   d->seconds += MPI_Wtime() - t0;
   return out;
 }
@@ -108,7 +151,7 @@ double sph_domain_min(sph_domain *d, double v) {
 double sph_domain_max(sph_domain *d, double v) {
   double out = v;
   if (d)
-    MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX);
   return out;
 }
 
@@ -123,7 +166,7 @@ void sph_domain_minmax(sph_domain *d, double *lo, double *hi, int n) {
       v[i] = lo[at + i];
       v[m + i] = -hi[at + i]; /* negation is exact: one MPI_MIN for both */
     }
-    MPI_Allreduce(v, r, 2 * m, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    allreduce(v, r, 2 * m, MPI_DOUBLE, MPI_MIN);
     for (int i = 0; i < m; ++i) {
       lo[at + i] = r[i];
       hi[at + i] = -r[m + i];
@@ -137,8 +180,7 @@ void sph_domain_sum(sph_domain *d, double *v, int count) {
     return;
   double mine[16], *all = d->sums;
   memcpy(mine, v, (size_t)count * sizeof *v);
-  MPI_Allgather(mine, count, MPI_DOUBLE, all, count, MPI_DOUBLE,
-                MPI_COMM_WORLD);
+  allgather(mine, count, MPI_DOUBLE, all);
   for (int c = 0; c < count; ++c) {
     double s = 0.0;
     for (int q = 0; q < d->size; ++q)
@@ -154,8 +196,7 @@ void sph_domain_sum_long(sph_domain *d, double *v, size_t count, double *work,
   double t0 = MPI_Wtime();
   for (size_t off = 0; off < count; off += chunk) {
     size_t m = count - off < chunk ? count - off : chunk;
-    MPI_Allgather(v + off, (int)m, MPI_DOUBLE, work, (int)m, MPI_DOUBLE,
-                  MPI_COMM_WORLD);
+    allgather(v + off, (int)m, MPI_DOUBLE, work);
     for (size_t c = 0; c < m; ++c) {
       double s = 0.0;
       for (int q = 0; q < d->size; ++q)
@@ -167,16 +208,18 @@ void sph_domain_sum_long(sph_domain *d, double *v, size_t count, double *work,
 }
 
 int sph_domain_bcast_int(sph_domain *d, int v) {
-  if (d)
-    MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Request r;
+  if (d && MPI_Ibcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD, &r) == MPI_SUCCESS)
+    sph_domain_wait(1, &r);
   return v;
 }
 
 void sph_domain_gather_u64(sph_domain *d, const uint64_t *v, int count,
                            uint64_t *out) {
-  if (d)
-    MPI_Gather(v, count, MPI_UINT64_T, out, count, MPI_UINT64_T, 0,
-               MPI_COMM_WORLD);
+  MPI_Request r;
+  if (d && MPI_Igather(v, count, MPI_UINT64_T, out, count, MPI_UINT64_T, 0,
+                       MPI_COMM_WORLD, &r) == MPI_SUCCESS)
+    sph_domain_wait(1, &r);
 }
 
 sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
@@ -184,7 +227,7 @@ sph_status sph_domain_agree(sph_domain *d, sph_status st, sph_error *err) {
     return st;
   int mine = st != SPH_OK ? d->rank : d->size, first = d->size;
   double t0 = MPI_Wtime();
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  allreduce(&mine, &first, 1, MPI_INT, MPI_MIN);
   d->seconds += MPI_Wtime() - t0;
   if (first == d->size)
     return SPH_OK;

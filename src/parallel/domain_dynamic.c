@@ -259,7 +259,7 @@ static int swap(sph_domain *d, int w) {
     if (y->cs[q])
       MPI_Isend(d->buf + (size_t)w * (size_t)y->os[q], w * y->cs[q], MPI_DOUBLE,
                 q, 8, MPI_COMM_WORLD, &req[nr++]);
-  return MPI_Waitall(nr, req, MPI_STATUSES_IGNORE) == MPI_SUCCESS;
+  return sph_domain_wait(nr, req) == MPI_SUCCESS;
 }
 
 /* the particles of this rank that belong elsewhere, to their owners */

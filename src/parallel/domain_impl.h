@@ -37,6 +37,11 @@ struct sph_domain {
   sph_domain_dyn *dyn; /* updated-Lagrangian runs, else NULL */
 };
 
+/* MPI only: waits for the n MPI_Requests at req, polling about 50 us, then
+ * sleeping 50 us between polls (SPH_MPI_WAIT=spin: polling only); the MPI
+ * return code. */
+int sph_domain_wait(int n, void *req);
+
 typedef struct rcb_key {
   double x;
   int64_t i;

@@ -5,6 +5,7 @@
  * libyaml's emitter. */
 #include <ctype.h>
 #include <errno.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -57,32 +58,67 @@ static sph_status add_child(loader *L, sph_node *parent, const char *key,
   return SPH_OK;
 }
 
+/* FNV-1a: the slot of a key in a mapping's set of keys. */
+static uint64_t key_hash(const char *key) {
+  uint64_t h = 14695981039346656037u;
+  for (const unsigned char *c = (const unsigned char *)key; *c; ++c)
+    h = (h ^ *c) * 1099511628211u;
+  return h;
+}
+
+/* The earlier index of key among n->keys, or -1 after adding it (index
+ * n->count) to the open-addressed set (cap a power of two, over twice the
+ * pairs): one look-up per key, so a mapping of n keys is checked in O(n). */
+static long key_seen(const sph_node *n, size_t *set, size_t cap,
+                     const char *key) {
+  for (size_t s = key_hash(key) & (cap - 1);; s = (s + 1) & (cap - 1)) {
+    if (!set[s]) {
+      set[s] = n->count + 1;
+      return -1;
+    }
+    if (strcmp(n->keys[set[s] - 1], key) == 0)
+      return (long)(set[s] - 1);
+  }
+}
+
 static sph_status convert_map(loader *L, yaml_node_t *y, sph_node *n,
                               int depth) {
+  size_t pairs =
+             (size_t)(y->data.mapping.pairs.top - y->data.mapping.pairs.start),
+         cap = 8;
+  while (cap < 2 * pairs + 2)
+    cap *= 2;
+  size_t *set = calloc(cap, sizeof *set); /* index + 1 of a key, 0 free */
+  if (!set)
+    return sph_error_set(L->err, SPH_ERR_NOMEM, "scene tree");
+  sph_status st = SPH_OK;
   for (yaml_node_pair_t *pr = y->data.mapping.pairs.start;
-       pr < y->data.mapping.pairs.top; ++pr) {
+       pr < y->data.mapping.pairs.top && st == SPH_OK; ++pr) {
     yaml_node_t *k = yaml_document_get_node(L->doc, pr->key);
     yaml_node_t *v = yaml_document_get_node(L->doc, pr->value);
     int kl = (int)k->start_mark.line + 1, kc = (int)k->start_mark.column + 1;
-    if (k->type != YAML_SCALAR_NODE)
-      return sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, kl, kc, n->path,
-                          "mapping keys must be plain names, not %s",
-                          k->type == YAML_MAPPING_NODE ? "mappings"
-                                                       : "sequences");
+    if (k->type != YAML_SCALAR_NODE) {
+      st =
+          sph_error_at(L->err, SPH_ERR_SYNTAX, L->file, kl, kc, n->path,
+                       "mapping keys must be plain names, not %s",
+                       k->type == YAML_MAPPING_NODE ? "mappings" : "sequences");
+      break;
+    }
     const char *key = (const char *)k->data.scalar.value;
-    for (size_t i = 0; i < n->count; ++i)
-      if (strcmp(n->keys[i], key) == 0) {
-        char *path = sph_node_join_key(n->path, key);
-        sph_status st = sph_error_at(
-            L->err, SPH_ERR_DUPLICATE_KEY, L->file, kl, kc, path ? path : key,
-            "duplicate key '%s' (first given on line %d)", key,
-            n->items[i]->line);
-        free(path);
-        return st;
-      }
-    SPH_TRY(add_child(L, n, key, v, kl, kc, depth + 1));
+    long first = key_seen(n, set, cap, key);
+    if (first >= 0) {
+      char *path = sph_node_join_key(n->path, key);
+      st = sph_error_at(L->err, SPH_ERR_DUPLICATE_KEY, L->file, kl, kc,
+                        path ? path : key,
+                        "duplicate key '%s' (first given on line %d)", key,
+                        n->items[first]->line);
+      free(path);
+      break;
+    }
+    st = add_child(L, n, key, v, kl, kc, depth + 1);
   }
-  return SPH_OK;
+  free(set);
+  return st;
 }
 
 static sph_status convert(loader *L, yaml_node_t *y, const char *path, int line,
@@ -315,16 +351,19 @@ sph_status sph_node_load_file(sph_node **root, const char *path,
   char *text = malloc(cap);
   while (text) {
     len += fread(text + len, 1, cap - len, f);
-    if (len < cap)
-      break;
     if (len > SPH_SCENE_MAX_BYTES) {
       free(text);
       fclose(f);
       return sph_error_at(err, SPH_ERR_RANGE, path, 0, 0, NULL,
-                          "not a scene: more than %d bytes",
+                          "not a scene: more than 1 MiB (%d bytes)",
                           SPH_SCENE_MAX_BYTES);
     }
-    char *t = realloc(text, cap *= 2);
+    if (len < cap)
+      break;
+    /* the last read asks for one byte past the limit: a file of exactly
+     * SPH_SCENE_MAX_BYTES is read whole, one byte more is refused */
+    cap = cap * 2 > SPH_SCENE_MAX_BYTES ? SPH_SCENE_MAX_BYTES + 1 : cap * 2;
+    char *t = realloc(text, cap);
     if (!t)
       free(text);
     text = t;

@@ -4,7 +4,8 @@
 # files (check_mpi.py: fields, frames and probes identical, energies to 1e-12
 # relative, the .pvtp series read by VTK with the serial particles and
 # arrays); the same rank count twice writes the same bytes; --overwrite
-# removes a 4-rank run's pieces; more ranks than useful and other commands
+# removes a 4-rank run's pieces; the banner notes more ranks x threads than
+# cores; more ranks than useful and other commands
 # than run are refused with exit 2 before anything is written. Usage:
 # run_mpi_test.sh SPH SOURCE_DIR
 set -u
@@ -35,6 +36,21 @@ check "np 2 --overwrite of np 4" "${mpi[@]}" -np 2 "$sph" "${run[@]}" \
   --out "$work/np4" --overwrite
 no_stale() { ! ls "$work/np4" | grep -q '_p[23]\.vtp'; }
 check "no stale pieces" no_stale
+
+# more ranks x threads on the node than cores: the banner says so (issue 36)
+cores=$(getconf _NPROCESSORS_ONLN)
+banner_note() { # threads, the note's pattern, 1 if it must be there else 0
+  "${mpi[@]}" -np 2 "$sph" run twisting_column --set time.end=0.005 \
+    --set output.png.width=320 --set output.png.height=180 \
+    --set output.png.mp4=false --threads "$1" --out "$work/note" \
+    --overwrite >"$work/note.txt" 2>&1 || return 1
+  grep -q "$2" "$work/note.txt"
+  [ $? -eq $((1 - $3)) ] || { cat "$work/note.txt"; return 1; }
+}
+check "banner: 2 ranks x $cores threads oversubscribed" banner_note "$cores" \
+  "^  note       2 ranks x $cores threads\? on $cores cores\?: oversubscribed" 1
+[ "$cores" -ge 2 ] &&
+  check "banner: 2 ranks x 1 thread, no note" banner_note 1 "^  note " 0
 
 # refusals: exit 2 on every rank, the folder never made
 expect="more than useful"

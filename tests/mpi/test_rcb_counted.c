@@ -5,6 +5,8 @@
  * of every cut) is the whole set's on every rank, with the caller's work
  * room or its own. Lattices with many equal coordinates (ties by index,
  * cuts between equal coordinates), signed zeros, a 2D set, random points.
+ * Also: waiting ranks yield (issue 36): sph_domain_init sets
+ * OMPI_MCA_mpi_yield_when_idle=1 only when unset, and OpenMPI has it.
  * Run under mpirun (ctest: 2, 3 and 4 ranks). */
 #include "parallel/domain_impl.h"
 
@@ -12,6 +14,7 @@
 #include <math.h>
 #include <mpi.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "mpi_check.h"
 
@@ -149,6 +152,49 @@ START_TEST(test_random_points) {
 }
 END_TEST
 
+/* OpenMPI's mpi_yield_when_idle as MPI_T reads it (-1: not found) */
+static int yield_when_idle(void) {
+  int provided, n = 0, on = -1;
+  MPI_T_init_thread(MPI_THREAD_SINGLE, &provided);
+  MPI_T_cvar_get_num(&n);
+  for (int i = 0; i < n; ++i) {
+    char name[256], desc[256];
+    int nl = sizeof name, dl = sizeof desc, verb, bind, scope;
+    MPI_Datatype type;
+    MPI_T_enum en;
+    if (MPI_T_cvar_get_info(i, name, &nl, &verb, &type, &en, desc, &dl, &bind,
+                            &scope) != MPI_SUCCESS ||
+        strcmp(name, "mpi_yield_when_idle"))
+      continue;
+    MPI_T_cvar_handle h;
+    int count;
+    unsigned char v[16] = {0}; /* a bool: any non-zero byte */
+    MPI_T_cvar_handle_alloc(i, NULL, &h, &count);
+    MPI_T_cvar_read(h, v);
+    MPI_T_cvar_handle_free(&h);
+    on = 0;
+    for (size_t b = 0; b < sizeof v; ++b)
+      on |= v[b] != 0;
+  }
+  MPI_T_finalize();
+  return on;
+}
+
+START_TEST(test_waiting_ranks_yield) {
+  /* set by sph_domain_init before MPI_Init (ctest leaves it unset; mpirun
+   * sets it itself when oversubscribed), and OpenMPI read it */
+  ck_assert_str_eq(getenv("OMPI_MCA_mpi_yield_when_idle"), "1");
+  ck_assert_int_eq(yield_when_idle(), 1);
+  /* the user's choice is kept */
+  ck_assert_int_eq(setenv("OMPI_MCA_mpi_yield_when_idle", "0", 1), 0);
+  ck_assert_int_eq(sph_domain_idle_defaults(), 0);
+  ck_assert_str_eq(getenv("OMPI_MCA_mpi_yield_when_idle"), "0");
+  ck_assert_int_eq(unsetenv("OMPI_MCA_mpi_yield_when_idle"), 0);
+  ck_assert_int_eq(sph_domain_idle_defaults(), 1);
+  ck_assert_str_eq(getenv("OMPI_MCA_mpi_yield_when_idle"), "1");
+}
+END_TEST
+
 int main(int argc, char **argv) {
   sph_error err;
   if (sph_domain_init(&argc, &argv, &err) != SPH_OK)
@@ -159,6 +205,7 @@ int main(int argc, char **argv) {
   tcase_add_test(tc, test_signed_zeros_and_cube);
   tcase_add_test(tc, test_plane);
   tcase_add_test(tc, test_random_points);
+  tcase_add_test(tc, test_waiting_ranks_yield);
   suite_add_tcase(s, tc);
   return sph_mpi_check_run(s);
 }

@@ -153,6 +153,20 @@ START_TEST(oversized_and_deeply_nested_input_refused_fast) {
   close(fd);
   ck_assert_int_eq(sph_node_load_file(&root, big, &err), SPH_ERR_RANGE);
   ck_assert_ptr_nonnull(strstr(err.message, "not a scene"));
+  /* the limit is exactly 1 MiB (issue 36: it was 2 MiB): one byte more is
+   * refused, 1 MiB of comment is read */
+  ck_assert_int_eq(truncate(big, (1 << 20) + 1), 0);
+  ck_assert_int_eq(sph_node_load_file(&root, big, &err), SPH_ERR_RANGE);
+  ck_assert_str_eq(err.message, "not a scene: more than 1 MiB (1048576 bytes)");
+  FILE *f = fopen(big, "wb");
+  ck_assert_ptr_nonnull(f);
+  fputs("a: 1\n#", f);
+  for (long i = 7; i < (1 << 20) - 1; ++i)
+    fputc('x', f);
+  fputc('\n', f);
+  fclose(f);
+  ck_assert_int_eq(sph_node_load_file(&root, big, &err), SPH_OK);
+  sph_node_destroy(root);
   unlink(big);
   /* 320 kB of nested brackets: refused before the parser (which needs
    * seconds for it) at the first bracket too deep */
@@ -232,6 +246,51 @@ START_TEST(duplicate_key_is_an_error) {
   ck_assert_int_eq(err.line, 1);
   ck_assert_int_eq(err.col, 11);
   ck_assert_str_eq(err.key, "m.x");
+}
+END_TEST
+
+/* ~900 kB mappings of n keys "kNNNNNNN: 1" under "m:", with keys[dup]
+ * repeated at the end when dup >= 0; the load time in seconds */
+static double load_many_keys(long n, long dup, sph_status want,
+                             sph_error *err) {
+  size_t cap = 16 + (size_t)(n + 1) * 16;
+  char *text = malloc(cap), *p = text;
+  ck_assert_ptr_nonnull(text);
+  p += sprintf(p, "m:\n");
+  for (long i = 0; i < n; ++i)
+    p += sprintf(p, "  k%07ld: 1\n", i);
+  if (dup >= 0)
+    p += sprintf(p, "  k%07ld: 2\n", dup);
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  sph_node *root = NULL;
+  ck_assert_int_eq(sph_node_load_string(&root, text, "many.yaml", err), want);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  if (want == SPH_OK)
+    ck_assert_uint_eq(sph_node_child(root, "m")->count, (size_t)n);
+  sph_node_destroy(root);
+  free(text);
+  return (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
+}
+
+START_TEST(many_keys_are_checked_in_linear_time) {
+  /* issue 36: the duplicate-key check compared each key with every earlier
+   * one (a 900 kB scene took 17 s); now one hash look-up a key. The bound is
+   * loose for a busy machine: the load takes about 0.2 s */
+  long n = 900000 / 13;
+  sph_error err;
+  double ok = load_many_keys(n, -1, SPH_OK, &err);
+  double dup = load_many_keys(n, 12345, SPH_ERR_DUPLICATE_KEY, &err);
+  printf("many_keys: %ld keys loaded in %.3f s, refused in %.3f s\n", n, ok,
+         dup);
+  ck_assert_double_lt(ok, 5.0);
+  ck_assert_double_lt(dup, 5.0);
+  /* the second occurrence, as before */
+  ck_assert_int_eq(err.line, (int)n + 2);
+  ck_assert_int_eq(err.col, 3);
+  ck_assert_str_eq(err.key, "m.k0012345");
+  ck_assert_str_eq(err.message,
+                   "duplicate key 'k0012345' (first given on line 12347)");
 }
 END_TEST
 
@@ -851,6 +910,7 @@ int main(void) {
   tcase_add_test(tc, oversized_and_deeply_nested_input_refused_fast);
   tcase_add_test(tc, aliases_are_copied_and_cycles_refused);
   tcase_add_test(tc, duplicate_key_is_an_error);
+  tcase_add_test(tc, many_keys_are_checked_in_linear_time);
   tcase_add_test(tc, syntax_errors_have_a_location);
   tcase_add_test(tc, unknown_key_suggests);
   tcase_add_test(tc, scalar_conversions);
