@@ -734,7 +734,7 @@ static sph_status resume_distributed(const char *dir, sph_sim *sim,
                           ? "; the folder holds the checkpoint of a run "
                             "without MPI (" SPH_CHECKPOINT_FILE
                             "): resume it without mpirun"
-                          : "");
+                          : "; start the run again with --overwrite");
 }
 
 sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
@@ -771,7 +771,20 @@ sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
                           "mpirun -np %d",
                           why[0], why[1], m.ranks, slot_name[s], m.ranks);
   }
+  /* stopped (or a full disk) before its first checkpoint: start again */
+  char first[1100];
+  struct stat sb;
+  snprintf(first, sizeof first, "%s/%s", dir, SPH_CHECKPOINT_FILE);
+  if (stat(first, &sb) != 0 && errno == ENOENT &&
+      snprintf(first, sizeof first, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS) >
+          0 &&
+      stat(first, &sb) != 0 && errno == ENOENT)
+    return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
+                        "no checkpoint to resume from: the run stopped "
+                        "before its first one; start it again with "
+                        "--overwrite (or write elsewhere with --out DIR)");
   return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
-                      "no valid checkpoint to resume from (%.360s; %.360s)",
+                      "no valid checkpoint to resume from (%.300s; %.300s); "
+                      "start the run again with --overwrite",
                       why[0], why[1]);
 }

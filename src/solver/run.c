@@ -111,11 +111,14 @@ static sph_status folder_check(sph_run *run, sph_error *err) {
   if (!run->opt.overwrite && !run->opt.resume &&
       (sph_run_file_exists(run->dir, "summary.json") ||
        sph_run_file_exists(run->dir, "scene_used.yaml")))
-    st = sph_error_set(err, SPH_ERR_ARG,
-                       "%s holds the results of an earlier run; pass "
-                       "--overwrite to replace them or --out DIR to write "
-                       "elsewhere",
-                       run->dir);
+    st = sph_error_set(
+        err, SPH_ERR_ARG,
+        "%s holds the results of an earlier run; pass %s--overwrite to "
+        "replace them or --out DIR to write elsewhere",
+        run->dir,
+        sph_run_file_exists(run->dir, SPH_CHECKPOINT_FILE)
+            ? "--resume to continue it if it stopped, "
+            : "");
   return st;
 }
 
