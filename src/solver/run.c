@@ -84,6 +84,13 @@ sph_status sph_run_open(sph_run **out, const sph_scene *scene,
   return SPH_OK;
 }
 
+int sph_run_frame_count(const sph_run *run) {
+  int n = 0;
+  while (n < 100000 && output_time(run, n) < run->scene->t_end - run_eps(run))
+    ++n;
+  return n + 1;
+}
+
 /* rank 0 makes, locks and checks the folder for every rank */
 static sph_status folder_check(sph_run *run, sph_error *err) {
   const char *given = run->opt.out_dir;
@@ -119,6 +126,12 @@ static sph_status folder_check(sph_run *run, sph_error *err) {
         sph_run_file_exists(run->dir, SPH_CHECKPOINT_FILE)
             ? "--resume to continue it if it stopped, "
             : "");
+  /* then only files of earlier runs (their manifest) are replaced */
+  if (st == SPH_OK)
+    st = sph_run_manifest_start(
+        run->dir, run->scene->name, sph_run_frame_count(run),
+        run->sim->domain ? sph_domain_size(run->sim->domain) : 1,
+        run->opt.overwrite && !run->opt.resume, err);
   return st;
 }
 
@@ -130,8 +143,6 @@ sph_status sph_run_folder(sph_run *run, sph_error *err) {
   SPH_TRY(sph_domain_agree(sim->domain, st, err));
   if (run->opt.no_files)
     return SPH_OK;
-  if (run->opt.overwrite && !run->opt.resume && run->root)
-    sph_run_remove_previous(run->dir, run->scene->name);
   run->halo = sph_domain_halo(sim->domain); /* collective */
   /* rank 0's probes' particles, from their owners */
   if (sim->domain && run->scene->output.nprobes) {
@@ -540,6 +551,12 @@ sph_status sph_run_close(sph_run *run, sph_summary *summary, sph_error *err) {
                                      s->output.png.fps, &r->mp4, &r->mp4_err);
   if (!run->opt.no_files && !r->io_failed && run->root)
     summary_write(run, r, completed);
+  /* the manifest: the files written and their sizes */
+  if (!run->opt.no_files && run->root &&
+      sph_run_manifest_close(run->dir, &cerr) != SPH_OK && !r->io_failed) {
+    r->io_failed = 1;
+    run->err = cerr;
+  }
   if (summary)
     summary_fill(run, summary);
   if (r->io_failed) {
