@@ -17,6 +17,13 @@ static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
     sph_node *it = list->items[i];
     if (it->kind != SPH_NODE_SCALAR)
       return sph_node_error(it, err, SPH_ERR_TYPE, "expected a field name");
+    for (size_t j = 0; j < i; ++j) /* a field written twice: refused */
+      if (list->items[j]->kind == SPH_NODE_SCALAR &&
+          !strcmp(list->items[j]->value, it->value))
+        return sph_node_error(it, err, SPH_ERR_RANGE,
+                              "field '%s' is listed twice (first at %d:%d)",
+                              it->value, list->items[j]->line,
+                              list->items[j]->col);
     if (allow_ids && !strcmp(it->value, "body_id")) {
       s->output.body_id = 1;
       continue;
