@@ -552,7 +552,8 @@ static sph_status read_header(reader *r, const char *path, const manifest *m,
     FAIL("%lld bytes, a checkpoint of this run holds at most %zu: damaged, "
          "or not its checkpoint",
          w->size, w->limit);
-  if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1)
+  if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1 ||
+      h.next_output > 100000)
     FAIL("time %g or output index %d out of range", h.t, h.next_output);
   if (m && (h.t != m->t || h.steps != m->step))
     FAIL("at step %llu, its manifest at step %llu", (unsigned long long)h.steps,
@@ -569,6 +570,9 @@ static sph_status read_verdict(reader *r, const char *path, const sph_sim *sim,
     if (!get(r, (char *)vv + verdict_fields[i].off, verdict_fields[i].size))
       FAIL("truncated verdict");
   vv->reason[sizeof vv->reason - 1] = '\0';
+  sph_error ve;
+  if (sph_verdict_check_restored(vv, &ve) != SPH_OK)
+    FAIL("%s", ve.message);
   uint32_t ncalls = 0;
   if (!get(r, &ncalls, 4))
     FAIL("truncated call counts");
