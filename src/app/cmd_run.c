@@ -153,7 +153,7 @@ static int run_open(const sph_app_args *args, const char *path,
   }
   if (sph_run_folder(*run, &err) != SPH_OK) {
     sph_app_print_error(&err);
-    return SPH_EXIT_USAGE;
+    return sph_app_exit_code(err.code); /* 3: the manifest not written */
   }
   if (!args->quiet)
     banner(sph_run_view(*run), sph_run_dir(*run), sph_run_halo(*run));

@@ -345,7 +345,7 @@ static sph_status manifest_write(const char *dir, int slot, const sph_sim *sim,
 
 /* Rank 0: the slot to write, the one not holding the newest complete
  * checkpoint; its manifest is removed before any piece is rewritten. */
-static int slot_to_write(const char *dir) {
+static int slot_to_write(const char *dir, int replace) {
   manifest m[2];
   int valid[2];
   for (int s = 0; s < 2; ++s) {
@@ -356,17 +356,17 @@ static int slot_to_write(const char *dir) {
   int newest = valid[0] && (!valid[1] || m[0].step >= m[1].step) ? 0
                : valid[1]                                        ? 1
                                                                  : -1;
-  return newest == 0 ? 1 : 0;
+  return newest < 0 ? 0 : replace ? newest : 1 - newest;
 }
 
 static sph_status write_distributed(const char *dir, const sph_sim *sim,
                                     const sph_verdict *v, int next_output,
-                                    sph_error *err) {
+                                    int replace, sph_error *err) {
   sph_domain *d = sim->domain;
   int rank = sph_domain_rank(d), ranks = sph_domain_size(d), slot = 0;
   char path[1100], name[64];
   if (rank == 0) {
-    slot = slot_to_write(dir);
+    slot = slot_to_write(dir, replace);
     manifest_path(path, sizeof path, dir, slot);
     remove(path);
   }
@@ -397,16 +397,17 @@ static sph_status write_distributed(const char *dir, const sph_sim *sim,
   return sph_domain_agree(d, st, err);
 }
 
-sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
-                                const sph_verdict *v, int next_output,
-                                sph_error *err) {
+sph_status sph_checkpoint_write_as(const char *dir, const sph_sim *sim,
+                                   const sph_verdict *v, int next_output,
+                                   int replace, sph_error *err) {
   if (sim->domain)
-    return write_distributed(dir, sim, v, next_output, err);
+    return write_distributed(dir, sim, v, next_output, replace, err);
   char path[1024], prev[1100];
   snprintf(path, sizeof path, "%s/%s", dir, SPH_CHECKPOINT_FILE);
   snprintf(prev, sizeof prev, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS);
   piece_sum sum;
-  return write_file(path, prev, sim, v, next_output, &sum, err);
+  return write_file(path, replace ? NULL : prev, sim, v, next_output, &sum,
+                    err);
 }
 
 /* ---- reading

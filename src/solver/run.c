@@ -129,7 +129,7 @@ static sph_status folder_check(sph_run *run, sph_error *err) {
   /* then only files of earlier runs (their manifest) are replaced */
   if (st == SPH_OK)
     st = sph_run_manifest_start(
-        run->dir, run->scene->name, sph_run_frame_count(run),
+        run->dir, run->scene, sph_run_frame_count(run),
         run->sim->domain ? sph_domain_size(run->sim->domain) : 1,
         run->opt.overwrite && !run->opt.resume, err);
   return st;
@@ -169,12 +169,22 @@ static sph_status sinks_open(sph_run *run, sph_error *err) {
   return sph_domain_agree(run->sim->domain, st, err);
 }
 
+/* whether the checkpoint resumed from is one the cadence wrote (its step
+ * passed a multiple of checkpoint_every), not a stop's */
+static int on_cadence(const sph_run *run) {
+  double every = run->scene->output.checkpoint_every, eps = run_eps(run);
+  double t = run->sim->t, t0 = t - run->sim->dt_last;
+  return every > 0.0 && floor((t + eps) / every) > floor((t0 + eps) / every);
+}
+
 sph_status sph_run_start(sph_run *run, sph_error *err) {
   sph_sim *sim = run->sim;
   SPH_TRY(sph_verdict_create(&run->verdict, sim, err)); /* collective */
-  if (run->opt.resume && !run->opt.no_files)
+  if (run->opt.resume && !run->opt.no_files) {
     SPH_TRY(sph_checkpoint_resume(run->dir, sim, run->verdict, &run->index,
                                   run->resumed, sizeof run->resumed, err));
+    run->ckpt_replace = !on_cadence(run);
+  }
   run->started = 1;
   if (run->opt.no_files)
     return SPH_OK;
@@ -323,7 +333,9 @@ static sph_status step_once(sph_run *run, sph_error *err) {
     double ckpt = run->scene->output.checkpoint_every;
     st = sinks_flush(run, 1, err);
     if (st == SPH_OK)
-      st = sph_checkpoint_write(run->dir, sim, run->verdict, run->index, err);
+      st = sph_checkpoint_write_as(run->dir, sim, run->verdict, run->index,
+                                   run->ckpt_replace, err);
+    run->ckpt_replace = 0;
     run->next_ckpt += ckpt * floor((sim->t - run->next_ckpt) / ckpt + 1.0);
   }
   return st;
@@ -337,8 +349,9 @@ static void run_stop(sph_run *run, int value) {
     return;
   run->st = sinks_flush(run, 0, &run->err);
   if (run->st == SPH_OK)
-    run->st = sph_checkpoint_write(run->dir, run->sim, run->verdict, run->index,
-                                   &run->err);
+    run->st = sph_checkpoint_write_as(run->dir, run->sim, run->verdict,
+                                      run->index, run->ckpt_replace, &run->err);
+  run->ckpt_replace = 1; /* off the cadence: the next one replaces it */
 }
 
 /* a started, open run with its first output frame written */

@@ -95,8 +95,9 @@ static const entry *find(const names *m, const char *name) {
 }
 
 /* every file a run of `scene` with `frames` output frames over `ranks`
- * MPI ranks may write here */
-static int planned(names *m, const char *scene, int frames, int ranks) {
+ * MPI ranks may write here (frames: VTK files with vtk, PNG with png) */
+static int planned(names *m, const char *scene, int frames, int ranks, int vtk,
+                   int png) {
   static const char *const fixed[] = {"summary.json",
                                       "energy.csv",
                                       "probes.csv",
@@ -115,14 +116,14 @@ static int planned(names *m, const char *scene, int frames, int ranks) {
   }
   for (int i = 0; i < frames && !bad; ++i) {
     snprintf(name, sizeof name, "%s_%04d.vtp", scene, i);
-    bad |= add_both(m, name);
+    bad |= vtk && ranks == 1 && add_both(m, name);
     snprintf(name, sizeof name, "frames/%s_%04d.png", scene, i);
-    bad |= add_both(m, name);
-    for (int r = 0; ranks > 1 && r < ranks && !bad; ++r) {
+    bad |= png && add_both(m, name);
+    for (int r = 0; vtk && ranks > 1 && r < ranks && !bad; ++r) {
       snprintf(name, sizeof name, "%s_%04d_p%d.vtp", scene, i, r);
       bad |= add_both(m, name);
     }
-    if (ranks > 1) {
+    if (vtk && ranks > 1) {
       snprintf(name, sizeof name, "%s_%04d.pvtp", scene, i);
       bad |= add_both(m, name);
     }
@@ -192,13 +193,14 @@ static int frames_linked(const char *dir) {
   return lstat(path, &st) == 0 && S_ISLNK(st.st_mode);
 }
 
-sph_status sph_run_manifest_start(const char *dir, const char *scene,
+sph_status sph_run_manifest_start(const char *dir, const sph_scene *scene,
                                   int frames, int ranks, int overwrite,
                                   sph_error *err) {
   names old = {0}, plan = {0};
   sph_status st = SPH_OK;
   manifest_read(dir, &old);
-  if (planned(&plan, scene, frames, ranks))
+  if (planned(&plan, scene->name, frames, ranks, scene->output.vtk,
+              scene->output.png.enabled))
     st = sph_error_set(err, SPH_ERR_NOMEM, "output manifest");
   sort_unique(&plan);
   int link = frames_linked(dir);
@@ -207,7 +209,13 @@ sph_status sph_run_manifest_start(const char *dir, const char *scene,
     const char *n = plan.e[i].name;
     long long size = size_of(dir, n, link);
     const entry *e = find(&old, n);
-    if (size != -2 && (!e || size == -3))
+    if (size == -3)
+      st = sph_error_set(err, SPH_ERR_ARG,
+                         "%s/%s is not a regular file (a link, a FIFO or a "
+                         "folder) and sph never writes through one; move it "
+                         "away or write elsewhere with --out DIR",
+                         dir, n);
+    else if (size != -2 && !e)
       st = sph_error_set(err, SPH_ERR_ARG,
                          "%s/%s is not a file an earlier sph run wrote "
                          "here (not in %s/" MANIFEST "); move it away or "
