@@ -178,8 +178,8 @@ static sph_status check_step_count(const sph_scene *s, sph_node *root,
   sph_node *key = mat ? sph_node_child(mat, "density") : NULL;
   sph_node *time = sph_node_child(root, "time");
   sph_node *end = time ? sph_node_child(time, "end") : NULL;
-  if (end && !strcmp(end->file, "<command line>") &&
-      (!key || strcmp(key->file, "<command line>")))
+  if (end && end->file && !strcmp(end->file, "<command line>") &&
+      (!key || !key->file || strcmp(key->file, "<command line>")))
     key = end; /* the --set that made it so */
   return sph_node_error(
       key ? key : mat, err, SPH_ERR_RANGE,
