@@ -176,6 +176,9 @@ static sph_status check_step_count(const sph_scene *s, sph_node *root,
                       ? mats->items[m]
                       : sph_node_child(root, "time");
   sph_node *key = mat ? sph_node_child(mat, "density") : NULL;
+  if (mat && !sph_node_from_command_line(key) &&
+      sph_node_from_command_line(mat))
+    key = mat; /* reported at the material's key --set gave */
   sph_node *time = sph_node_child(root, "time");
   sph_node *end = time ? sph_node_child(time, "end") : NULL;
   if (end && end->file && !strcmp(end->file, "<command line>") &&

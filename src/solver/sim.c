@@ -7,6 +7,7 @@
 #include "core/tensor.h"
 #include "parallel/domain.h"
 #include "scene/geometry.h"
+#include "scene/node.h"
 #include "solver/reference.h"
 
 #include <math.h>
@@ -348,6 +349,7 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   if (st == SPH_OK)
     st = check_sim(sim, err);
   if (st != SPH_OK) {
+    sph_node_blame_set(scene->root, scene->path, err);
     sph_sim_destroy(sim);
     return st;
   }
