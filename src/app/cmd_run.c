@@ -156,9 +156,19 @@ static int run_open(const sph_app_args *args, const char *path,
             strlen(given));
     return SPH_EXIT_USAGE;
   }
+  /* a stop before the folder is touched: nothing written, nothing to do */
+  int early = (int)sph_domain_max(sph_run_sim(*run)->domain, stop_signal);
+  if (early) {
+    printf("stopped by %s before anything was written\n",
+           early == SIGINT    ? "SIGINT"
+           : early == SIGTERM ? "SIGTERM"
+           : early == SIGHUP  ? "SIGHUP"
+                              : "a signal");
+    return 128 + early;
+  }
   if (sph_run_folder(*run, &err) != SPH_OK) {
     sph_app_print_error(&err);
-    return SPH_EXIT_USAGE;
+    return sph_app_exit_code(err.code); /* 3: the manifest not written */
   }
   if (!args->quiet)
     banner(sph_run_view(*run), sph_run_dir(*run), sph_run_halo(*run));
@@ -240,10 +250,12 @@ int sph_cmd_run(int argc, char **argv) {
   sph_scene *scene = NULL;
   sph_run *run = NULL;
   sph_progress prog;
+  /* first: a stop while the scene loads or the folder is made is a stop
+   * like any other (issue 36 item 5); over MPI ranks every rank catches
+   * them and they agree on stopping */
+  catch_stop_signals();
   rc = run_open(&args, path, &scene, &run, &prog);
   if (rc == SPH_EXIT_OK) {
-    /* over MPI ranks every rank catches them; they agree on stopping */
-    catch_stop_signals();
     sph_progress_start(&prog, scene->t_end, args.quiet || !root);
     sph_error err;
     sph_error_clear(&err);

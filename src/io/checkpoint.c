@@ -345,7 +345,7 @@ static sph_status manifest_write(const char *dir, int slot, const sph_sim *sim,
 
 /* Rank 0: the slot to write, the one not holding the newest complete
  * checkpoint; its manifest is removed before any piece is rewritten. */
-static int slot_to_write(const char *dir) {
+static int slot_to_write(const char *dir, int replace) {
   manifest m[2];
   int valid[2];
   for (int s = 0; s < 2; ++s) {
@@ -356,17 +356,17 @@ static int slot_to_write(const char *dir) {
   int newest = valid[0] && (!valid[1] || m[0].step >= m[1].step) ? 0
                : valid[1]                                        ? 1
                                                                  : -1;
-  return newest == 0 ? 1 : 0;
+  return newest < 0 ? 0 : replace ? newest : 1 - newest;
 }
 
 static sph_status write_distributed(const char *dir, const sph_sim *sim,
                                     const sph_verdict *v, int next_output,
-                                    sph_error *err) {
+                                    int replace, sph_error *err) {
   sph_domain *d = sim->domain;
   int rank = sph_domain_rank(d), ranks = sph_domain_size(d), slot = 0;
   char path[1100], name[64];
   if (rank == 0) {
-    slot = slot_to_write(dir);
+    slot = slot_to_write(dir, replace);
     manifest_path(path, sizeof path, dir, slot);
     remove(path);
   }
@@ -397,16 +397,17 @@ static sph_status write_distributed(const char *dir, const sph_sim *sim,
   return sph_domain_agree(d, st, err);
 }
 
-sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
-                                const sph_verdict *v, int next_output,
-                                sph_error *err) {
+sph_status sph_checkpoint_write_as(const char *dir, const sph_sim *sim,
+                                   const sph_verdict *v, int next_output,
+                                   int replace, sph_error *err) {
   if (sim->domain)
-    return write_distributed(dir, sim, v, next_output, err);
+    return write_distributed(dir, sim, v, next_output, replace, err);
   char path[1024], prev[1100];
   snprintf(path, sizeof path, "%s/%s", dir, SPH_CHECKPOINT_FILE);
   snprintf(prev, sizeof prev, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS);
   piece_sum sum;
-  return write_file(path, prev, sim, v, next_output, &sum, err);
+  return write_file(path, replace ? NULL : prev, sim, v, next_output, &sum,
+                    err);
 }
 
 /* ---- reading
@@ -552,7 +553,8 @@ static sph_status read_header(reader *r, const char *path, const manifest *m,
     FAIL("%lld bytes, a checkpoint of this run holds at most %zu: damaged, "
          "or not its checkpoint",
          w->size, w->limit);
-  if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1)
+  if (!(h.t >= 0.0 && h.t <= sim->scene->t_end) || h.next_output < 1 ||
+      h.next_output > 100000)
     FAIL("time %g or output index %d out of range", h.t, h.next_output);
   if (m && (h.t != m->t || h.steps != m->step))
     FAIL("at step %llu, its manifest at step %llu", (unsigned long long)h.steps,
@@ -569,6 +571,9 @@ static sph_status read_verdict(reader *r, const char *path, const sph_sim *sim,
     if (!get(r, (char *)vv + verdict_fields[i].off, verdict_fields[i].size))
       FAIL("truncated verdict");
   vv->reason[sizeof vv->reason - 1] = '\0';
+  sph_error ve;
+  if (sph_verdict_check_restored(vv, &ve) != SPH_OK)
+    FAIL("%s", ve.message);
   uint32_t ncalls = 0;
   if (!get(r, &ncalls, 4))
     FAIL("truncated call counts");
@@ -734,7 +739,7 @@ static sph_status resume_distributed(const char *dir, sph_sim *sim,
                           ? "; the folder holds the checkpoint of a run "
                             "without MPI (" SPH_CHECKPOINT_FILE
                             "): resume it without mpirun"
-                          : "");
+                          : "; start the run again with --overwrite");
 }
 
 sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
@@ -771,7 +776,20 @@ sph_status sph_checkpoint_resume(const char *dir, sph_sim *sim, sph_verdict *v,
                           "mpirun -np %d",
                           why[0], why[1], m.ranks, slot_name[s], m.ranks);
   }
+  /* stopped (or a full disk) before its first checkpoint: start again */
+  char first[1100];
+  struct stat sb;
+  snprintf(first, sizeof first, "%s/%s", dir, SPH_CHECKPOINT_FILE);
+  if (stat(first, &sb) != 0 && errno == ENOENT &&
+      snprintf(first, sizeof first, "%s/%s", dir, SPH_CHECKPOINT_PREVIOUS) >
+          0 &&
+      stat(first, &sb) != 0 && errno == ENOENT)
+    return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
+                        "no checkpoint to resume from: the run stopped "
+                        "before its first one; start it again with "
+                        "--overwrite (or write elsewhere with --out DIR)");
   return sph_error_at(err, SPH_ERR_IO, dir, 0, 0, NULL,
-                      "no valid checkpoint to resume from (%.360s; %.360s)",
+                      "no valid checkpoint to resume from (%.300s; %.300s); "
+                      "start the run again with --overwrite",
                       why[0], why[1]);
 }

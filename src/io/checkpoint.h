@@ -52,10 +52,19 @@ sph_status sph_checkpoint_scene_crc(const sph_scene *s, unsigned *crc,
                                     sph_error *err);
 
 /* Writes DIR/checkpoint.sphc atomically, keeping the one before as
- * checkpoint.prev.sphc. */
-sph_status sph_checkpoint_write(const char *dir, const sph_sim *sim,
-                                const sph_verdict *v, int next_output,
-                                sph_error *err);
+ * checkpoint.prev.sphc (over MPI ranks: into the slot not holding the
+ * newest). With replace, the newest is replaced instead (the one a stop
+ * wrote between the cadence's), so a resumed run ends with the
+ * uninterrupted one's files. */
+sph_status sph_checkpoint_write_as(const char *dir, const sph_sim *sim,
+                                   const sph_verdict *v, int next_output,
+                                   int replace, sph_error *err);
+static inline sph_status sph_checkpoint_write(const char *dir,
+                                              const sph_sim *sim,
+                                              const sph_verdict *v,
+                                              int next_output, sph_error *err) {
+  return sph_checkpoint_write_as(dir, sim, v, next_output, 0, err);
+}
 
 /* Loads the newest valid checkpoint of DIR into sim and v (method state,
  * time, step counters, verdict); *next_output receives the index of the

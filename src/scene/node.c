@@ -150,10 +150,54 @@ sph_node *sph_node_child(const sph_node *map, const char *key) {
   return NULL;
 }
 
+const sph_node *sph_node_from_command_line(const sph_node *n) {
+  if (!n)
+    return NULL;
+  if (n->file && !strcmp(n->file, "<command line>"))
+    return n;
+  for (size_t i = 0; i < n->count; ++i) {
+    const sph_node *c = sph_node_from_command_line(n->items[i]);
+    if (c)
+      return c;
+  }
+  return NULL;
+}
+
+static const sph_node *node_at_path(const sph_node *n, const char *path) {
+  if (n->path && !strcmp(n->path, path))
+    return n;
+  for (size_t i = 0; i < n->count; ++i) {
+    const sph_node *c = node_at_path(n->items[i], path);
+    if (c)
+      return c;
+  }
+  return NULL;
+}
+
+void sph_node_blame_set(const sph_node *root, const char *file,
+                        sph_error *err) {
+  if (!root || !err || !err->key[0] || strcmp(err->file, file))
+    return;
+  const sph_node *n = node_at_path(root, err->key);
+  const sph_node *set = n ? sph_node_from_command_line(n) : NULL;
+  if (!set || set == n)
+    return;
+  snprintf(err->file, sizeof err->file, "%s", set->file);
+  err->line = set->line;
+  err->col = set->col;
+  sph_key_path_fit(err->key, sizeof err->key, set->path);
+}
+
 sph_status sph_node_error(const sph_node *n, sph_error *err, sph_status code,
                           const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
+  /* an error at a key whose value --set changed inside it (an element of a
+   * list, a key of a map) is the command line's (issue 36 item 7) */
+  const sph_node *set =
+      n && n->path && n->path[0] ? sph_node_from_command_line(n) : NULL;
+  if (set)
+    n = set;
   if (n)
     sph_error_atv(err, code, n->file, n->line, n->col, n->path, fmt, ap);
   else

@@ -54,7 +54,15 @@ sph_status sph_node_set(sph_node *root, const char *assignment, sph_error *err);
 sph_status sph_node_check_keys(const sph_node *map, const char *const *allowed,
                                sph_error *err);
 
-/* Error at a node: fills file, line, col and key (the node's path). */
+/* The first node at or under n that --set gave (origin "<command line>"),
+ * or NULL; sph_node_error reports at it. */
+const sph_node *sph_node_from_command_line(const sph_node *n);
+/* An error placed in `file` at a key (err->key, a node's path) that holds
+ * a value --set gave: re-placed at that value (set-up errors found after
+ * the tree, e.g. a probe outside every body). */
+void sph_node_blame_set(const sph_node *root, const char *file, sph_error *err);
+/* Error at a node: fills file, line, col and key (the node's path); at the
+ * node --set gave when one is at or under it (never for the root). */
 sph_status sph_node_error(const sph_node *n, sph_error *err, sph_status code,
                           const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));

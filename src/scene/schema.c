@@ -14,6 +14,9 @@
 #include "scene/schema_impl.h"
 #include "solver/stability.h"
 
+/* the most time steps a scene may need (check_step_count) */
+#define SPH_STEPS_MAX 1e12
+
 const char *const sph_axis_names[] = {"x", "y", "z", NULL};
 
 /* (schema_impl.h) */
@@ -149,6 +152,48 @@ static sph_status parse_stability(sph_scene *s, sph_node *root,
   return SPH_OK;
 }
 
+/* A run needs at least time.end * c / dp steps (a CFL number <= 1, c the
+ * p-wave speed): more than 1e12 is no physical scene (a density of 1e-300)
+ * and is refused at the density of the fastest body's material. */
+static sph_status check_step_count(const sph_scene *s, sph_node *root,
+                                   sph_error *err) {
+  double most = 0.0;
+  size_t at = 0;
+  for (size_t b = 0; b < s->nbodies; ++b) {
+    const sph_body *body = &s->bodies[b];
+    double c = sph_material_wave_speed(&s->materials[body->material]);
+    double steps = body->spacing > 0.0 ? s->t_end * c / body->spacing : 0.0;
+    if (!(steps <= most)) { /* NaN too */
+      most = steps;
+      at = b;
+    }
+  }
+  if (most <= SPH_STEPS_MAX)
+    return SPH_OK;
+  int m = s->bodies[at].material;
+  sph_node *mats = sph_node_child(root, "materials");
+  sph_node *mat = mats && (size_t)m < mats->count
+                      ? mats->items[m]
+                      : sph_node_child(root, "time");
+  sph_node *key = mat ? sph_node_child(mat, "density") : NULL;
+  if (mat && !sph_node_from_command_line(key) &&
+      sph_node_from_command_line(mat))
+    key = mat; /* reported at the material's key --set gave */
+  sph_node *time = sph_node_child(root, "time");
+  sph_node *end = time ? sph_node_child(time, "end") : NULL;
+  if (end && end->file && !strcmp(end->file, "<command line>") &&
+      (!key || !key->file || strcmp(key->file, "<command line>")))
+    key = end; /* the --set that made it so */
+  return sph_node_error(
+      key ? key : mat, err, SPH_ERR_RANGE,
+      "body %s would need at least %.3g time steps (wave "
+      "speed %.3g m/s in material %s, spacing %.3g m, end "
+      "%g s); at most %.0e: check the material's density "
+      "and elastic constants",
+      s->bodies[at].name, most, sph_material_wave_speed(&s->materials[m]),
+      s->materials[m].name, s->bodies[at].spacing, s->t_end, SPH_STEPS_MAX);
+}
+
 static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   if (root->kind != SPH_NODE_MAP)
     return sph_node_error(root, err, SPH_ERR_TYPE,
@@ -190,6 +235,7 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   SPH_TRY(parse_kernel(s, root, err));
   SPH_TRY(sph_schema_materials(s, root, err));
   SPH_TRY(sph_schema_bodies(s, root, err));
+  SPH_TRY(check_step_count(s, root, err));
   SPH_TRY(sph_schema_boundaries(s, root, err));
   if (sph_node_child(root, "body_force")) {
     s->has_body_force = 1;

@@ -2,6 +2,7 @@
  * checkpoints; the PNG frames' block is the PNG sink's own
  * (render/png_schema.c). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,6 +17,13 @@ static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
     sph_node *it = list->items[i];
     if (it->kind != SPH_NODE_SCALAR)
       return sph_node_error(it, err, SPH_ERR_TYPE, "expected a field name");
+    for (size_t j = 0; j < i; ++j) /* a field written twice: refused */
+      if (list->items[j]->kind == SPH_NODE_SCALAR &&
+          !strcmp(list->items[j]->value, it->value))
+        return sph_node_error(it, err, SPH_ERR_RANGE,
+                              "field '%s' is listed twice (first at %d:%d)",
+                              it->value, list->items[j]->line,
+                              list->items[j]->col);
     if (allow_ids && !strcmp(it->value, "body_id")) {
       s->output.body_id = 1;
       continue;
@@ -47,6 +55,19 @@ static sph_status field_list(sph_scene *s, sph_node *list, int *fields,
   return SPH_OK;
 }
 
+/* The node an error of the output interval against the run's end belongs
+ * to: time.end when only it was given on the command line (--set), else
+ * output.every */
+static sph_node *every_node(sph_node *root, sph_node *out) {
+  sph_node *every = sph_node_child(out, "every");
+  sph_node *time = sph_node_child(root, "time");
+  sph_node *end = time ? sph_node_child(time, "end") : NULL;
+  int end_set = end && end->file && !strcmp(end->file, "<command line>");
+  int every_set =
+      every && every->file && !strcmp(every->file, "<command line>");
+  return end_set && !every_set ? end : every;
+}
+
 sph_status sph_schema_output(sph_scene *s, sph_node *root, sph_error *err) {
   sph_node *out;
   SPH_TRY(sph_node_insert_default(root, "output", "{}", &out, err));
@@ -59,16 +80,22 @@ sph_status sph_schema_output(sph_scene *s, sph_node *root, sph_error *err) {
   SPH_TRY(
       sph_node_get_positive(out, "every", 0, s->t_end / 100.0, &o->every, err));
   if (o->every > s->t_end * (1 + 1e-12))
-    return sph_node_error(sph_node_child(out, "every"), err, SPH_ERR_RANGE,
+    return sph_node_error(every_node(root, out), err, SPH_ERR_RANGE,
                           "output interval %g is longer than the run (%g)",
                           o->every, s->t_end);
   /* frame numbers have four digits (<scene>_NNNN.vtp, .png) */
   double frames = ceil(s->t_end / o->every * (1.0 - 1e-12)) + 1.0;
-  if (frames > 10000.0)
-    return sph_node_error(sph_node_child(out, "every"), err, SPH_ERR_RANGE,
-                          "%.0f output frames (end %g s every %g s); at "
+  if (frames > 10000.0) {
+    char count[40]; /* no 300-digit counts */
+    if (frames < 1e15)
+      snprintf(count, sizeof count, "%.0f", frames);
+    else
+      snprintf(count, sizeof count, "%.3g", frames);
+    return sph_node_error(every_node(root, out), err, SPH_ERR_RANGE,
+                          "%s output frames (end %g s every %g s); at "
                           "most 10000: a longer interval, or a shorter run",
-                          frames, s->t_end, o->every);
+                          count, s->t_end, o->every);
+  }
   sph_node *fields;
   SPH_TRY(sph_node_insert_default(
       out, "fields",

@@ -84,6 +84,13 @@ sph_status sph_run_open(sph_run **out, const sph_scene *scene,
   return SPH_OK;
 }
 
+int sph_run_frame_count(const sph_run *run) {
+  int n = 0;
+  while (n < 100000 && output_time(run, n) < run->scene->t_end - run_eps(run))
+    ++n;
+  return n + 1;
+}
+
 /* rank 0 makes, locks and checks the folder for every rank */
 static sph_status folder_check(sph_run *run, sph_error *err) {
   const char *given = run->opt.out_dir;
@@ -111,11 +118,20 @@ static sph_status folder_check(sph_run *run, sph_error *err) {
   if (!run->opt.overwrite && !run->opt.resume &&
       (sph_run_file_exists(run->dir, "summary.json") ||
        sph_run_file_exists(run->dir, "scene_used.yaml")))
-    st = sph_error_set(err, SPH_ERR_ARG,
-                       "%s holds the results of an earlier run; pass "
-                       "--overwrite to replace them or --out DIR to write "
-                       "elsewhere",
-                       run->dir);
+    st = sph_error_set(
+        err, SPH_ERR_ARG,
+        "%s holds the results of an earlier run; pass %s--overwrite to "
+        "replace them or --out DIR to write elsewhere",
+        run->dir,
+        sph_run_file_exists(run->dir, SPH_CHECKPOINT_FILE)
+            ? "--resume to continue it if it stopped, "
+            : "");
+  /* then only files of earlier runs (their manifest) are replaced */
+  if (st == SPH_OK)
+    st = sph_run_manifest_start(
+        run->dir, run->scene, sph_run_frame_count(run),
+        run->sim->domain ? sph_domain_size(run->sim->domain) : 1,
+        run->opt.overwrite && !run->opt.resume, err);
   return st;
 }
 
@@ -127,8 +143,6 @@ sph_status sph_run_folder(sph_run *run, sph_error *err) {
   SPH_TRY(sph_domain_agree(sim->domain, st, err));
   if (run->opt.no_files)
     return SPH_OK;
-  if (run->opt.overwrite && !run->opt.resume && run->root)
-    sph_run_remove_previous(run->dir, run->scene->name);
   run->halo = sph_domain_halo(sim->domain); /* collective */
   /* rank 0's probes' particles, from their owners */
   if (sim->domain && run->scene->output.nprobes) {
@@ -155,12 +169,22 @@ static sph_status sinks_open(sph_run *run, sph_error *err) {
   return sph_domain_agree(run->sim->domain, st, err);
 }
 
+/* whether the checkpoint resumed from is one the cadence wrote (its step
+ * passed a multiple of checkpoint_every), not a stop's */
+static int on_cadence(const sph_run *run) {
+  double every = run->scene->output.checkpoint_every, eps = run_eps(run);
+  double t = run->sim->t, t0 = t - run->sim->dt_last;
+  return every > 0.0 && floor((t + eps) / every) > floor((t0 + eps) / every);
+}
+
 sph_status sph_run_start(sph_run *run, sph_error *err) {
   sph_sim *sim = run->sim;
   SPH_TRY(sph_verdict_create(&run->verdict, sim, err)); /* collective */
-  if (run->opt.resume && !run->opt.no_files)
+  if (run->opt.resume && !run->opt.no_files) {
     SPH_TRY(sph_checkpoint_resume(run->dir, sim, run->verdict, &run->index,
                                   run->resumed, sizeof run->resumed, err));
+    run->ckpt_replace = !on_cadence(run);
+  }
   run->started = 1;
   if (run->opt.no_files)
     return SPH_OK;
@@ -309,7 +333,9 @@ static sph_status step_once(sph_run *run, sph_error *err) {
     double ckpt = run->scene->output.checkpoint_every;
     st = sinks_flush(run, 1, err);
     if (st == SPH_OK)
-      st = sph_checkpoint_write(run->dir, sim, run->verdict, run->index, err);
+      st = sph_checkpoint_write_as(run->dir, sim, run->verdict, run->index,
+                                   run->ckpt_replace, err);
+    run->ckpt_replace = 0;
     run->next_ckpt += ckpt * floor((sim->t - run->next_ckpt) / ckpt + 1.0);
   }
   return st;
@@ -323,8 +349,9 @@ static void run_stop(sph_run *run, int value) {
     return;
   run->st = sinks_flush(run, 0, &run->err);
   if (run->st == SPH_OK)
-    run->st = sph_checkpoint_write(run->dir, run->sim, run->verdict, run->index,
-                                   &run->err);
+    run->st = sph_checkpoint_write_as(run->dir, run->sim, run->verdict,
+                                      run->index, run->ckpt_replace, &run->err);
+  run->ckpt_replace = 1; /* off the cadence: the next one replaces it */
 }
 
 /* a started, open run with its first output frame written */
@@ -537,6 +564,12 @@ sph_status sph_run_close(sph_run *run, sph_summary *summary, sph_error *err) {
                                      s->output.png.fps, &r->mp4, &r->mp4_err);
   if (!run->opt.no_files && !r->io_failed && run->root)
     summary_write(run, r, completed);
+  /* the manifest: the files written and their sizes */
+  if (!run->opt.no_files && run->root &&
+      sph_run_manifest_close(run->dir, &cerr) != SPH_OK && !r->io_failed) {
+    r->io_failed = 1;
+    run->err = cerr;
+  }
   if (summary)
     summary_fill(run, summary);
   if (r->io_failed) {

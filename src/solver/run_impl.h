@@ -39,7 +39,8 @@ struct sph_run {
   int started, begun, closed, derived;
   sph_status st; /* the first failure of the set-up, a step or an output */
   sph_error err;
-  int stopped; /* the stop flag's value, agreed over the ranks */
+  int stopped;      /* the stop flag's value, agreed over the ranks */
+  int ckpt_replace; /* the newest checkpoint is a stop's: replaced next */
   double wall0, comm0, next_ckpt;
   double *scratch; /* id and body as doubles (2 * capacity) */
   sph_run_report report;
@@ -48,7 +49,17 @@ struct sph_run {
 
 /* run_folder.c */
 sph_status sph_run_lock(sph_run *run, sph_error *err);
-void sph_run_remove_previous(const char *dir, const char *scene);
+/* rank 0, before anything is written: refuses a file under a name the run
+ * writes that no earlier run wrote (the manifest DIR/.sph.manifest), with
+ * overwrite removes the earlier runs' files, then writes the manifest of
+ * what this run may write */
+sph_status sph_run_manifest_start(const char *dir, const sph_scene *scene,
+                                  int frames, int ranks, int overwrite,
+                                  sph_error *err);
+/* rank 0, once the run is closed: the manifest lists the files written,
+ * with their sizes */
+sph_status sph_run_manifest_close(const char *dir, sph_error *err);
+int sph_run_frame_count(const sph_run *run);
 int sph_run_file_exists(const char *dir, const char *name);
 sph_status sph_run_write_scene_used(const sph_run *run, sph_error *err);
 void sph_run_provenance(const sph_run *run, sph_provenance *prov);

@@ -7,13 +7,37 @@
 #include "core/tensor.h"
 #include "parallel/domain.h"
 #include "scene/geometry.h"
+#include "scene/node.h"
 #include "solver/memory.h"
 #include "solver/reference.h"
 
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* A singular moment matrix names its particle by id and position
+ * (src/core/corrections.c); the error gains the particle's body and is
+ * placed at that body's entry in the scene file. */
+static void blame_singular(const sph_sim *sim, sph_error *err) {
+  const char *at = err ? strstr(err->message, "at particle ") : NULL;
+  long long id;
+  if (!at || err->code != SPH_ERR_SINGULAR || sscanf(at + 12, "%lld", &id) != 1)
+    return;
+  const sph_particles *ps = sim->ps;
+  const sph_scene *s = sim->scene;
+  for (size_t a = 0; a < ps->n; ++a)
+    if (ps->id[a] == id && ps->body[a] >= 0 &&
+        (size_t)ps->body[a] < s->nbodies) {
+      const sph_body *b = &s->bodies[ps->body[a]];
+      char msg[sizeof err->message];
+      snprintf(msg, sizeof msg, "%s", err->message);
+      sph_error_at(err, err->code, s->path, b->line, b->col, NULL,
+                   "body %s: %s", b->name, msg);
+      return;
+    }
+}
 
 /* The node of an output.fields / probe fields entry naming `name`, or the
  * list itself. */
@@ -328,6 +352,8 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
     st = sph_reference_initialise(sim->reference, sim, err);
   if (st == SPH_OK)
     st = method->setup(sim, scene->method, err);
+  if (st == SPH_ERR_SINGULAR)
+    blame_singular(sim, err);
   /* a rank whose set-up failed alone must not leave the others waiting */
   if (sim->domain)
     st = sph_domain_agree(sim->domain, st, err);
@@ -343,6 +369,7 @@ sph_status sph_sim_create(sph_sim **out, const sph_scene *scene,
   if (st == SPH_OK)
     st = check_sim(sim, err);
   if (st != SPH_OK) {
+    sph_node_blame_set(scene->root, scene->path, err);
     sph_sim_destroy(sim);
     return st;
   }
@@ -398,6 +425,8 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
             "time step %g at t = %g (stable %g, cap %g)", dt, sim->t,
             sim->dt_stable_peak, dt_cap);
   sph_status st = sim->method->step(sim, dt, err);
+  if (st == SPH_ERR_SINGULAR)
+    blame_singular(sim, err);
   /* a rank's failed check reaches every rank through the agreement */
   if (st == SPH_OK)
     st = check_particles(sim->ps, err);

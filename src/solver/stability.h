@@ -169,6 +169,9 @@ typedef struct sph_verdict {
 
 sph_status sph_verdict_create(sph_verdict **out, const sph_sim *sim,
                               sph_error *err);
+/* stability_check.c: the counts and flags a checkpoint restored are in
+ * range (SPH_ERR_IO otherwise) */
+sph_status sph_verdict_check_restored(const sph_verdict *v, sph_error *err);
 void sph_verdict_destroy(sph_verdict *v);
 
 /* Updates the indicators from a frame (after method->derive); fails only

@@ -35,7 +35,7 @@ done
 # an analytic initial state the material cannot have: refused at check
 for u0 in 1e20 1e308; do
   "$sph" check "$src/scenes/swinging_cube.yaml" --set reference.U0=$u0 2>"$work/stderr" >/dev/null
-  [ $? -eq 2 ] && grep -q "reference: the analytic initial state is" "$work/stderr" && ok ||
+  [ $? -eq 2 ] && grep -q "<command line>:1:14: reference.U0: the analytic initial state is" "$work/stderr" && ok ||
     bad "reference.U0=$u0: $(cat "$work/stderr")"
 done
 
@@ -46,6 +46,37 @@ done
 [ $? -eq 2 ] && grep -qF "did you mean 'poisson_ratio'" "$work/stderr" && ok || bad "--set typo: $(cat "$work/stderr")"
 "$sph" check "$src/scenes/twisting_column.yaml" --set bodies.3.name=x 2>"$work/stderr"
 [ $? -eq 2 ] && grep -qF "past the end" "$work/stderr" && ok || bad "--set index: $(cat "$work/stderr")"
+# a --set error is the command line's, also where it combines with a scene
+# key (issue 36 item 7), and no 300-digit counts (item 8)
+"$sph" check "$src/scenes/spinning_cube.yaml" --set time.end=1e300 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "sph: <command line>:1:10: time.end: " "$work/stderr" &&
+  ! grep -qE '[0-9]{20}' "$work/stderr" && ok || bad "--set time.end: $(cat "$work/stderr")"
+"$sph" check "$src/scenes/spinning_cube.yaml" --set time.end=1e-9 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "sph: <command line>:1:10: time.end: " "$work/stderr" && ok || bad "--set short end: $(cat "$work/stderr")"
+"$sph" check "$src/scenes/spinning_cube.yaml" --set output.every=1e-300 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "<command line>:1:14: output.every: 1e+299 output frames" "$work/stderr" && ok || bad "--set every: $(cat "$work/stderr")"
+"$sph" run "$src/scenes/spinning_cube.yaml" --out "$work/tiny" --set materials.rubber.density=1e-300 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -qF "<command line>:1:26: materials.rubber.density: body cube would need" "$work/stderr" &&
+  [ ! -e "$work/tiny" ] && ok || bad "--set density 1e-300: $(cat "$work/stderr")"
+# a --set inside a key (a list element, a map's key) or found wrong only
+# once the particles exist is the command line's error too (item 7)
+"$sph" check "$src/scenes/punch.yaml" --set method.jst.eps2_p=-1 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "sph: <command line>:1:19: method.jst.eps2_p: JST coefficients" "$work/stderr" && ok ||
+  bad "--set method.jst.eps2_p: $(cat "$work/stderr")"
+"$sph" check "$src/scenes/punch.yaml" --set output.probes.0.at.0=-1 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "sph: <command line>:1:22: output.probes[0].at[0]: probe 'punch_centre'" "$work/stderr" && ok ||
+  bad "--set probe outside: $(cat "$work/stderr")"
+"$sph" check "$src/scenes/punch.yaml" --set bodies.0.particles.count.1=1 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "sph: <command line>:1:" "$work/stderr" && ok ||
+  bad "--set count element: $(cat "$work/stderr")"
+"$sph" check "$src/scenes/punch.yaml" --set materials.soft.youngs_modulus=1e300 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "sph: <command line>:1:31: materials.soft.youngs_modulus: body block would need" "$work/stderr" && ok ||
+  bad "--set youngs_modulus 1e300: $(cat "$work/stderr")"
+# a singular moment matrix names the scene file, the body and the particle's
+# position (issue 36 item 7)
+"$sph" check "$src/scenes/spinning_cube.yaml" --set kernel.h_over_dp=0.9 2>"$work/stderr"
+[ $? -eq 2 ] && grep -qF "spinning_cube.yaml:18:5: body cube: singular" "$work/stderr" &&
+  grep -qF "at particle 0 (-0.5, -0.5, -0.5)" "$work/stderr" && ok || bad "singular: $(cat "$work/stderr")"
 "$sph" frobnicate 2>/dev/null
 [ $? -eq 2 ] && ok || bad "unknown command"
 "$sph" run --threads 0 2>/dev/null

@@ -77,5 +77,27 @@ for f in "$work"/ra/frames/*.png; do
 done
 [ $same -eq 51 ] || fail "frames after the resume: $same of 51 identical"
 
+# the checkpoint files too: a stop's checkpoint between two of the cadence's
+# is replaced by the resumed run's next one, so the resumed run ends with
+# the uninterrupted one's checkpoint.sphc and checkpoint.prev.sphc (issue
+# 36 item 8)
+# (cadence 0.5 s: checkpoints at 0.5 and 1 s, the stop between them)
+cargs=("${args[@]}" --set output.checkpoint_every=0.5)
+"$sph" run "$scene" --out "$work/cwhole" "${cargs[@]}" >/dev/null || fail "checkpointed run"
+"$sph" run "$scene" --out "$work/cterm" "${cargs[@]}" >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 300); do
+  [ -f "$work/cterm/twisting_column_0150.vtp" ] && break
+  sleep 0.02
+done
+kill -TERM $pid
+wait $pid
+grep -q '"t_reached": 0\.[5-9]' "$work/cterm/summary.json" ||
+  fail "the stop is not between the checkpoints: $(grep t_reached "$work/cterm/summary.json")"
+"$sph" run "$scene" --resume "$work/cterm" "${cargs[@]}" >/dev/null || fail "checkpointed resume"
+for f in checkpoint.sphc checkpoint.prev.sphc energy.csv; do
+  cmp -s "$work/cwhole/$f" "$work/cterm/$f" || fail "$f differs after the resume"
+done
+
 echo "$fails failures"
 [ $fails -eq 0 ]

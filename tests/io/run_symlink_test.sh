@@ -20,9 +20,10 @@ args=(--threads 1 --quiet --set 'bodies.0.particles.count=[5,25,5]'
 
 n=0
 # planted CODE NAME: a run whose folder holds NAME, a link to a file of
-# ours, must refuse it with exit CODE (2: at the start, as the lock and an
-# earlier run's files are; 3: a file that cannot be written, as a write
-# failure is), naming it, and leave the link's target as it was
+# ours, must refuse it with exit CODE (2: at the start, before anything is
+# written: a name the run writes that is no regular file of the folder's
+# manifest, issue 36 item 4), naming it, and leave the link's target as it
+# was
 planted() {
   local want=$1 name=$2
   shift 2
@@ -50,22 +51,22 @@ planted() {
 }
 
 planted 2 .sph.lock
-planted 3 energy.csv
-planted 3 probes.csv
-planted 3 twisting_column_0000.vtp
-planted 3 twisting_column_0003.vtp
-planted 3 twisting_column.pvd
-planted 3 twisting_column.pvd.part
+planted 2 energy.csv
+planted 2 probes.csv
+planted 2 twisting_column_0000.vtp
+planted 2 twisting_column_0003.vtp
+planted 2 twisting_column.pvd
+planted 2 twisting_column.pvd.part
 planted 2 summary.json
-planted 3 summary.json.part
+planted 2 summary.json.part
 planted 2 scene_used.yaml
-planted 3 scene_used.yaml.part
-planted 3 frames/twisting_column_0000.png
-planted 3 frames/twisting_column_0002.png.part
-planted 3 checkpoint.sphc
+planted 2 scene_used.yaml.part
+planted 2 frames/twisting_column_0000.png
+planted 2 frames/twisting_column_0002.png.part
+planted 2 checkpoint.sphc
 planted 3 frames
-planted 3 checkpoint.sphc.part
-planted 3 checkpoint.prev.sphc
+planted 2 checkpoint.sphc.part
+planted 2 checkpoint.prev.sphc
 
 # a stopped run's CSV tables are continued in place by --resume: a link
 # put in their place is refused, its target untouched
@@ -88,7 +89,7 @@ for name in probes.csv energy.csv; do
   "$sph" run "$scene" --resume "$work/resume_$name" "${args[@]}" --set output.png=false \
     --set time.end=1 >"$work/log" 2>&1
   rc=$?
-  [ $rc -eq 3 ] || fail "resume with $name a link: exit $rc, expected 3: $(tail -2 "$work/log")"
+  [ $rc -eq 2 ] || fail "resume with $name a link: exit $rc, expected 2: $(tail -2 "$work/log")"
   grep -q "$name" "$work/log" || fail "resume with $name a link: the message does not name it: $(tail -2 "$work/log")"
   cmp -s "$target" "$work/keep" || fail "resume with $name a link: its target was written"
 done

@@ -535,6 +535,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .dim = sim->scene->dimension,
                      .x = m->ref.X,
                      .volume = m->ref.V,
+                     .id = m->ref.id,
                      .nl = m->ref.nl,
                      .kernel = &sim->kernel};
   m->sweep = m->force == TL_JST_CONSERVATIVE ? sweep_conservative
