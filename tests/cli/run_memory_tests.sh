@@ -36,7 +36,7 @@ SPH_CGROUP_ROOT="$work/cg2" "$sph" check "$col" >/dev/null 2>"$work/stderr" && o
 # (c) the frame buffers: 16384 x 16384 needs 4.3 GB
 "$sph" check "$col" --set output.png.width=16384 --set output.png.height=16384 \
   --max-memory 1G >/dev/null 2>"$work/stderr"
-[ $? -eq 2 ] && grep -qF "output.png: the 16384 x 16384 frames need about 4.29 GB" "$work/stderr" && ok ||
+[ $? -eq 2 ] && grep -qF "the 16384 x 16384 frames need about 4.29 GB" "$work/stderr" && ok ||
   bad "16384^2 frames: $(cat "$work/stderr")"
 
 # (d) sph render applies the estimate to scene_used.yaml's particles

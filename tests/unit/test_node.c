@@ -223,7 +223,8 @@ START_TEST(aliases_are_copied_and_cycles_refused) {
                            "bomb.yaml", &err),
       SPH_ERR_RANGE);
   ck_assert_ptr_null(root);
-  ck_assert_ptr_nonnull(strstr(err.message, "nodes"));
+  /* the bytes the aliases copy are bounded before the node count is */
+  ck_assert_ptr_nonnull(strstr(err.message, "aliases expand the scene"));
 }
 END_TEST
 
