@@ -1,9 +1,19 @@
 #!/usr/bin/env python3
-"""compare.py BASE NEW: every file of BASE's runs equals NEW's byte for byte,
-except summary.json's timings and provenance and scene_used.yaml's two comment
-lines. Prints one line per scene and 'N passed, N failed'."""
-import json, os, sys
-base, new = sys.argv[1], sys.argv[2]
+"""compare.py BASE NEW [--ignore GLOB ...] [--only SCENE ...]: every file of
+BASE's runs equals NEW's byte for byte, except summary.json's timings and
+provenance and scene_used.yaml's two comment lines. --ignore skips files
+whose name matches GLOB (e.g. '*.png' for a change meant to alter frames
+only); --only compares the named scenes. Prints one line per scene and
+'N passed, N failed'."""
+import fnmatch, json, os, sys
+args = sys.argv[1:]
+ignore = []; only = []
+while '--ignore' in args:
+    i = args.index('--ignore'); ignore.append(args[i + 1]); del args[i:i + 2]
+while '--only' in args:
+    i = args.index('--only'); only.append(args[i + 1]); del args[i:i + 2]
+base, new = args[0], args[1]
+def skipped(f): return any(fnmatch.fnmatch(os.path.basename(f), g) for g in ignore)
 def norm_summary(b):
     d = json.loads(b)
     d.pop('sph', None); d.pop('wall_seconds', None); d.pop('render_thread_seconds', None)
@@ -17,7 +27,7 @@ def rc(root, n):
 ok = bad = 0
 for n in sorted(os.listdir(base)):
     b = os.path.join(base, n); m = os.path.join(new, n)
-    if not os.path.isdir(b): continue
+    if not os.path.isdir(b) or (only and n not in only): continue
     probs = []
     files = set()
     for r, _, fs in os.walk(b):
@@ -27,6 +37,7 @@ for n in sorted(os.listdir(base)):
         for r, _, fs in os.walk(m):
             for f in fs: nfiles.add(os.path.relpath(os.path.join(r, f), m))
     files -= {'.sph.lock', '.sph.manifest'}; nfiles -= {'.sph.lock', '.sph.manifest'}
+    files = {f for f in files if not skipped(f)}; nfiles = {f for f in nfiles if not skipped(f)}
     if files != nfiles: probs.append('files differ: only base %s, only new %s' % (sorted(files - nfiles)[:5], sorted(nfiles - files)[:5]))
     for f in sorted(files & nfiles):
         x = open(os.path.join(b, f), 'rb').read(); y = open(os.path.join(m, f), 'rb').read()
