@@ -126,6 +126,8 @@ void sph_app_provenance(struct sph_provenance *prov);
 
 /* Prints "sph: file:line:col: key: message" to stderr. */
 void sph_app_print_error(const sph_error *err);
+void sph_app_print_load_error(const sph_error *err, const char *const *sets,
+                              size_t nsets);
 
 /* Loads the scene with its overrides and creates the simulation; prints the
  * error and returns SPH_EXIT_USAGE on bad input. */

@@ -141,7 +141,7 @@ static int run_open(const sph_app_args *args, const char *path,
     st = sph_run_open(run, *scene, &opt, &hooks, &err);
   }
   if (st != SPH_OK) { /* out of memory: 3, as a run's (issue 36) */
-    sph_app_print_error(&err);
+    sph_app_print_load_error(&err, args->sets, args->nsets);
     return st == SPH_ERR_NOMEM ? SPH_EXIT_IO : SPH_EXIT_USAGE;
   }
   if (args->resume && args->out && strcmp(args->resume, args->out)) {

@@ -227,6 +227,27 @@ int sph_app_parse_args(int argc, char **argv, sph_app_args *args,
   return rc;
 }
 
+/* An error placed in the scene file of a scene that --set changed may follow
+ * from a changed key elsewhere (a box's min set past a boundary's plane, a
+ * body moved onto another): the note names the overrides (issue 36 item 7). */
+void sph_app_print_load_error(const sph_error *err, const char *const *sets,
+                              size_t nsets) {
+  sph_app_print_error(err);
+  if (nsets == 0 || sph_domain_world_rank() != 0 || !err->file[0] ||
+      !strcmp(err->file, "<command line>") || err->code == SPH_ERR_NOMEM ||
+      err->code == SPH_ERR_SYNTAX || err->code == SPH_ERR_DUPLICATE_KEY)
+    return;
+  fprintf(stderr, "sph: note: the command line changed this scene (");
+  for (size_t i = 0; i < nsets; ++i) {
+    const char *eq = strchr(sets[i], '=');
+    int len = eq ? (int)(eq - sets[i]) : (int)strlen(sets[i]);
+    fprintf(stderr, "%s--set %.*s", i ? ", " : "", len > 200 ? 200 : len,
+            sets[i]);
+  }
+  fprintf(stderr, "); the error may follow from %s\n",
+          nsets == 1 ? "it" : "them");
+}
+
 int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
                  sph_sim **sim) {
   sph_error err;
@@ -235,7 +256,7 @@ int sph_app_load(const sph_app_args *args, const char *path, sph_scene **scene,
                                       args->max_memory, scene, sim, &err);
   if (st == SPH_OK)
     return SPH_EXIT_OK;
-  sph_app_print_error(&err);
+  sph_app_print_load_error(&err, args->sets, args->nsets);
   return st == SPH_ERR_NOMEM ? SPH_EXIT_IO : SPH_EXIT_USAGE;
 }
 

@@ -55,6 +55,15 @@ done
 [ $? -eq 2 ] && grep -qF "sph: <command line>:1:10: time.end: " "$work/stderr" && ok || bad "--set short end: $(cat "$work/stderr")"
 "$sph" check "$src/scenes/spinning_cube.yaml" --set output.every=1e-300 2>"$work/stderr"
 [ $? -eq 2 ] && grep -qF "<command line>:1:14: output.every: 1e+299 output frames" "$work/stderr" && ok || bad "--set every: $(cat "$work/stderr")"
+# an error the file's key reports but a --set caused: the note names it
+for cmd in check "run --out $work/moved"; do
+  "$sph" $cmd "$src/scenes/punch.yaml" --set 'bodies.0.shape.box.min=[0.5,0,0]' 2>"$work/stderr" >/dev/null
+  [ $? -eq 2 ] && grep -qF "punch.yaml:22:5: boundaries[1].select: boundary 'left' selects no particle" "$work/stderr" &&
+    grep -qF "note: the command line changed this scene (--set bodies.0.shape.box.min); the error may follow from it" "$work/stderr" &&
+    [ ! -e "$work/moved" ] && ok || bad "--set moved box ($cmd): $(cat "$work/stderr")"
+done
+"$sph" check "$src/scenes/punch.yaml" --set 'bodies.0.shape.box.min=[0.5,0,0' 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && ! grep -qF "note:" "$work/stderr" && ok || bad "--set syntax error gets no note: $(cat "$work/stderr")"
 "$sph" run "$src/scenes/spinning_cube.yaml" --out "$work/tiny" --set materials.rubber.density=1e-300 2>"$work/stderr" >/dev/null
 [ $? -eq 2 ] && grep -qF "<command line>:1:26: materials.rubber.density: body cube would need" "$work/stderr" &&
   [ ! -e "$work/tiny" ] && ok || bad "--set density 1e-300: $(cat "$work/stderr")"
