@@ -1,0 +1,141 @@
+/* The host twin of the device step (docs/gpu.md): tl-jst pF over plain
+ * arrays by the per-particle functions of tl_jst_gpu_one.h in plain loops,
+ * the same functions the CUDA kernels (tl_jst_gpu.cu) call for their
+ * thread's index. Set up from a tl-jst sim, whose reference arrays it
+ * views and whose state it copies; what the device step lacks is refused
+ * here, naming the part. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "gpu/gpu.h"
+#include "materials/material_impl.h"
+#include "methods/tl_jst/tl_jst_impl.h"
+#include "scene/scene.h"
+#include "solver/sim.h"
+
+/* the parts of a tl-jst sim the device step does not have, or NULL */
+static const char *unsupported(const sph_sim *sim, const tl_jst *m) {
+  if (strcmp(sim->method->name, "tl-jst") != 0)
+    return "the method (only tl-jst has a device step)";
+  if (m->fields != TL_JST_PF)
+    return "tl-jst fields pFJ and pFHJ (only pF)";
+  if (m->force != TL_JST_CONSERVATIVE)
+    return "tl-jst force other than conservative";
+  if (m->ref.n_ext != m->ref.n || sim->domain)
+    return "mirror images and MPI ranks";
+  for (size_t a = 0; a < m->ref.n; ++a)
+    if (m->ref.mat[a]->ops != &sph_neo_hookean_ops)
+      return "materials other than neo-hookean";
+  for (int i = 0; i < sim->nterms; ++i)
+    if (strcmp(sim->terms[i].ops->name, "essential_bc") != 0)
+      return sim->terms[i].ops->name;
+  for (size_t k = 0; k < sim->scene->nboundaries; ++k)
+    if (sim->scene->boundaries[k].kind != SPH_BC_CLAMP)
+      return "boundaries other than clamp";
+  return NULL;
+}
+
+static void *host_alloc(size_t count, size_t size, int *ok) {
+  void *p = calloc(count ? count : 1, size);
+  *ok &= p != NULL;
+  return p;
+}
+
+/* bit c of fixed[a]: the clamp zeroes dp_c of particle a (the terms'
+ * rates on a rate of ones) */
+static sph_status clamp_mask(sph_sim *sim, const tl_jst *m,
+                             unsigned char *fixed, double *ones,
+                             sph_error *err) {
+  size_t n = m->ref.n;
+  for (size_t i = 0; i < 3 * n; ++i)
+    ones[i] = 1.0;
+  sph_stage s = {.t = sim->t, .x = m->x, .p = m->p, .F = m->F, .dp = ones};
+  SPH_TRY(sph_sim_terms_rates(sim, &s, err));
+  for (size_t a = 0; a < n; ++a) {
+    fixed[a] = 0;
+    for (int c = 0; c < 3; ++c)
+      if (ones[3 * a + c] == 0.0)
+        fixed[a] |= (unsigned char)(1u << c);
+  }
+  return SPH_OK;
+}
+
+sph_status sph_gpu_tl_jst_host_create(sph_sim *sim, sph_gpu_tl_jst *g,
+                                      int *stages, sph_error *err) {
+  memset(g, 0, sizeof *g);
+  const tl_jst *m = sim->method_data;
+  const char *why = unsupported(sim, m);
+  if (why)
+    return sph_error_set(err, SPH_ERR_UNSUPPORTED, "no device step for %s",
+                         why);
+  size_t n = m->ref.n, slots = m->ref.nl->offset[n];
+  *stages = m->integrate == sph_ssp_rk3_step ? 3 : 2;
+  g->n = n;
+  g->offset = m->ref.nl->offset;
+  g->index = m->ref.nl->index;
+  g->w = m->ref.w;
+  g->X = m->ref.X;
+  g->L = m->ref.L;
+  g->s = m->ref.s;
+  g->rho0 = m->ref.rho0;
+  (void)slots;
+  int ok = 1;
+  double *mu = host_alloc(n, sizeof *mu, &ok);
+  double *kappa = host_alloc(n, sizeof *kappa, &ok);
+  unsigned char *fixed = host_alloc(n, 1, &ok);
+  g->x = host_alloc(3 * n, sizeof(double), &ok);
+  g->p = host_alloc(3 * n, sizeof(double), &ok);
+  g->F = host_alloc(9 * n, sizeof(double), &ok);
+  g->x0 = host_alloc(3 * n, sizeof(double), &ok);
+  g->p0 = host_alloc(3 * n, sizeof(double), &ok);
+  g->F0 = host_alloc(9 * n, sizeof(double), &ok);
+  g->dx = host_alloc(3 * n, sizeof(double), &ok);
+  g->dp = host_alloc(3 * n, sizeof(double), &ok);
+  g->dF = host_alloc(9 * n, sizeof(double), &ok);
+  g->Qt = host_alloc(9 * n, sizeof(double), &ok);
+  g->mu = mu;
+  g->kappa = kappa;
+  g->fixed = fixed;
+  if (!ok) {
+    sph_gpu_tl_jst_host_destroy(g);
+    return sph_error_set(err, SPH_ERR_NOMEM, "device step host arrays");
+  }
+  for (size_t a = 0; a < n; ++a) {
+    mu[a] = m->ref.mat[a]->mu;
+    kappa[a] = m->ref.mat[a]->kappa;
+  }
+  memcpy(g->x, m->x, 3 * n * sizeof(double));
+  memcpy(g->p, m->p, 3 * n * sizeof(double));
+  memcpy(g->F, m->F, 9 * n * sizeof(double));
+  sph_status st = clamp_mask(sim, m, fixed, g->dp, err);
+  if (st != SPH_OK)
+    sph_gpu_tl_jst_host_destroy(g);
+  return st;
+}
+
+void sph_gpu_tl_jst_host_destroy(sph_gpu_tl_jst *g) {
+  free((void *)g->mu);
+  free((void *)g->kappa);
+  free((void *)g->fixed);
+  double *own[] = {g->x,  g->p,  g->F,  g->x0, g->p0,
+                   g->F0, g->dx, g->dp, g->dF, g->Qt};
+  for (size_t i = 0; i < sizeof own / sizeof *own; ++i)
+    free(own[i]);
+  memset(g, 0, sizeof *g);
+}
+
+void sph_gpu_tl_jst_twin_step(const sph_gpu_tl_jst *g, int stages, double dt) {
+  size_t n = g->n;
+  for (size_t a = 0; a < n; ++a)
+    sph_gpu_save_one(a, g);
+  for (int k = 0; k < stages; ++k) {
+    double ca, cb;
+    sph_gpu_rk_coefficients(stages, k, &ca, &cb);
+    for (size_t a = 0; a < n; ++a)
+      sph_gpu_stress_one(a, g);
+    for (size_t a = 0; a < n; ++a)
+      sph_gpu_rates_one(a, g);
+    for (size_t a = 0; a < n; ++a)
+      sph_gpu_combine_one(a, g, ca, cb, dt);
+  }
+}
