@@ -3,9 +3,10 @@
  * three kernels of one thread per particle, each calling the per-particle
  * function of tl_jst_gpu_one.h that the twin calls in a loop: the stress
  * (Q = P L), the rates (a gather over the particle's neighbour slots in
- * their fixed order: no atomics) and the Runge-Kutta combination with the
- * clamp. Built with --fmad=false, so that products and sums round as the
- * CPU's do; only pow in the stress may differ by an ulp from glibc's. */
+ * their fixed order: no atomics), with the JST term a second gather over
+ * the neighbours' L[p], and the Runge-Kutta combination with the clamp. Built
+ * with --fmad=false, so that products and sums round as the CPU's do; only pow
+ * in the stress may differ by an ulp from glibc's. */
 #include <cuda_runtime.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +42,12 @@ __global__ void rates_kernel(sph_gpu_tl_jst g) {
   size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
   if (a < g.n)
     sph_gpu_rates_one(a, &g);
+}
+
+__global__ void jst_kernel(sph_gpu_tl_jst g) {
+  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
+  if (a < g.n)
+    sph_gpu_jst_one(a, &g);
 }
 
 __global__ void combine_kernel(sph_gpu_tl_jst g, double ca, double cb,
@@ -107,6 +114,12 @@ static sph_status create_arrays(sph_gpu_step *s, const sph_gpu_tl_jst *h,
   UP(Qt, 9 * n, double);
   d->lap = NULL;
   d->lu = NULL;
+  d->c2 = h->c2;
+  d->c4 = h->c4;
+  if (h->lu) { /* the JST term */
+    UP(lap, slots, double);
+    UP(lu, 3 * n, double);
+  }
   return SPH_OK;
 }
 
@@ -138,6 +151,8 @@ extern "C" sph_status sph_gpu_tl_jst_advance(sph_gpu_step *s, double dt,
       sph_gpu_rk_coefficients(s->stages, k, &ca, &cb);
       stress_kernel<<<blocks, THREADS>>>(g);
       rates_kernel<<<blocks, THREADS>>>(g);
+      if (g.lu)
+        jst_kernel<<<blocks, THREADS>>>(g);
       combine_kernel<<<blocks, THREADS>>>(g, ca, cb, dt);
     }
   }

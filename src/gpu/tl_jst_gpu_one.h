@@ -6,7 +6,9 @@
  * loop, so the device algorithm is checked on a machine without a GPU. The
  * pair physics is methods/common/pair_iact.h's and the stress
  * materials/neo_hookean_law.h's, in the CPU method's order of operations
- * (methods/tl_jst/tl_jst.c): the twin equals the CPU step to the bit. */
+ * (methods/tl_jst/tl_jst.c), with the JST dissipation on p of eq. 35-38
+ * (terms/jst_dissipation.c, without the projection of eq. 49): the twin
+ * equals the CPU step to the bit. */
 #ifndef SPH_TL_JST_GPU_ONE_H
 #define SPH_TL_JST_GPU_ONE_H
 
@@ -34,7 +36,8 @@ typedef struct sph_gpu_tl_jst {
   double *x0, *p0, *F0;           /* the step's start */
   double *dx, *dp, *dF;           /* rates */
   double *Qt;                     /* (P L)^T per particle (9n) */
-  double *lu;                     /* L[p] for the JST term (3n) or NULL */
+  double *lu;    /* L[p] for the JST term (3n), NULL without it */
+  double c2, c4; /* JST: eps2 c_p h and eps4 c_p h^3 (seed 000 eq. 35) */
 } sph_gpu_tl_jst;
 
 /* Q_a = P_a L_a, transposed, of the stress of F_a (compute_stress) */
@@ -73,7 +76,8 @@ SPH_HD static inline void sph_gpu_rates_one(size_t a, const sph_gpu_tl_jst *g) {
   ref_iact_gradient_correct(G, g->L + 9 * a);
   for (int k = 0; k < 9; ++k)
     g->dF[9 * a + k] = G[k] * inv_rho0;
-  unsigned fix = g->fixed ? g->fixed[a] : 0u;
+  /* the clamp comes after the JST term's share (sph_gpu_jst_one) */
+  unsigned fix = g->fixed && !g->lu ? g->fixed[a] : 0u;
   for (int c = 0; c < 3; ++c) {
     g->dp[3 * a + c] = (fix & (1u << c)) ? 0.0 : f[c];
     g->dx[3 * a + c] = pa[c] * inv_rho0;
@@ -81,6 +85,34 @@ SPH_HD static inline void sph_gpu_rates_one(size_t a, const sph_gpu_tl_jst *g) {
   if (g->lu)
     for (int c = 0; c < 3; ++c)
       g->lu[3 * a + c] = l[c];
+}
+
+/* The JST term of particle a, once every L[p] is in (jst_rates):
+ * D = c2 L[p] - c4 L[L[p]] (D = c2 L[p] when c4 = 0), dp += D, then the
+ * clamp */
+SPH_HD static inline void sph_gpu_jst_one(size_t a, const sph_gpu_tl_jst *g) {
+  const double *la = g->lu + 3 * a;
+  double d[3];
+  if (g->c4 != 0.0) {
+    double s[3] = {0.0, 0.0, 0.0};
+    for (size_t k = g->offset[a]; k < g->offset[a + 1]; ++k) {
+      const double *lb = g->lu + 3 * (size_t)g->index[k];
+      s[0] += g->lap[k] * (lb[0] - la[0]);
+      s[1] += g->lap[k] * (lb[1] - la[1]);
+      s[2] += g->lap[k] * (lb[2] - la[2]);
+    }
+    for (int c = 0; c < 3; ++c)
+      d[c] = g->c2 * la[c] + -g->c4 * s[c];
+  } else {
+    for (int c = 0; c < 3; ++c)
+      d[c] = g->c2 * la[c];
+  }
+  unsigned fix = g->fixed ? g->fixed[a] : 0u;
+  for (int c = 0; c < 3; ++c) {
+    g->dp[3 * a + c] += d[c];
+    if (fix & (1u << c))
+      g->dp[3 * a + c] = 0.0;
+  }
 }
 
 /* y0 = y for particle a's x, p and F */

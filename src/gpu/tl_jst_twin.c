@@ -10,11 +10,13 @@
 #include "gpu/gpu.h"
 #include "materials/material_impl.h"
 #include "methods/tl_jst/tl_jst_impl.h"
+#include "scene/node.h"
 #include "scene/scene.h"
 #include "solver/sim.h"
 
 /* the parts of a tl-jst sim the device step does not have, or NULL */
 static const char *unsupported(const sph_sim *sim, const tl_jst *m) {
+  sph_error scratch;
   if (strcmp(sim->method->name, "tl-jst") != 0)
     return "the method (only tl-jst has a device step)";
   if (m->fields != TL_JST_PF)
@@ -26,9 +28,18 @@ static const char *unsupported(const sph_sim *sim, const tl_jst *m) {
   for (size_t a = 0; a < m->ref.n; ++a)
     if (m->ref.mat[a]->ops != &sph_neo_hookean_ops)
       return "materials other than neo-hookean";
-  for (int i = 0; i < sim->nterms; ++i)
-    if (strcmp(sim->terms[i].ops->name, "essential_bc") != 0)
-      return sim->terms[i].ops->name;
+  int jst_projection = 1;
+  sph_node *opt = sim->scene->method;
+  if (sph_node_child(opt, "jst_projection"))
+    sph_node_get_bool(opt, "jst_projection", 0, 1, &jst_projection, &scratch);
+  for (int i = 0; i < sim->nterms; ++i) {
+    const char *name = sim->terms[i].ops->name;
+    if (strcmp(name, "jst_dissipation_p") == 0 && jst_projection)
+      return "jst_projection (the JST term without it has one)";
+    if (strcmp(name, "essential_bc") != 0 &&
+        strcmp(name, "jst_dissipation_p") != 0)
+      return name;
+  }
   for (size_t k = 0; k < sim->scene->nboundaries; ++k)
     if (sim->scene->boundaries[k].kind != SPH_BC_CLAMP)
       return "boundaries other than clamp";
@@ -107,6 +118,21 @@ sph_status sph_gpu_tl_jst_host_create(sph_sim *sim, sph_gpu_tl_jst *g,
   memcpy(g->x, m->x, 3 * n * sizeof(double));
   memcpy(g->p, m->p, 3 * n * sizeof(double));
   memcpy(g->F, m->F, 9 * n * sizeof(double));
+  if (m->lu_p) { /* the JST term on p (tl_jst.c's setup_terms) */
+    double e2 = 0.0, e4 = 0.0;
+    sph_node *jst = sph_node_child(sim->scene->method, "jst");
+    sph_node_get_double(jst, "eps2_p", 0, 0.0, &e2, err);
+    sph_node_get_double(jst, "eps4_p", 0, 0.125, &e4, err);
+    double cp = m->ref.cp, h = sim->dp;
+    g->c2 = e2 * cp * h;
+    g->c4 = e4 * cp * h * h * h;
+    g->lap = m->lap;
+    g->lu = host_alloc(3 * n, sizeof(double), &ok);
+    if (!ok) {
+      sph_gpu_tl_jst_host_destroy(g);
+      return sph_error_set(err, SPH_ERR_NOMEM, "device step host arrays");
+    }
+  }
   sph_status st = clamp_mask(sim, m, fixed, g->dp, err);
   if (st != SPH_OK)
     sph_gpu_tl_jst_host_destroy(g);
@@ -117,8 +143,8 @@ void sph_gpu_tl_jst_host_destroy(sph_gpu_tl_jst *g) {
   free((void *)g->mu);
   free((void *)g->kappa);
   free((void *)g->fixed);
-  double *own[] = {g->x,  g->p,  g->F,  g->x0, g->p0,
-                   g->F0, g->dx, g->dp, g->dF, g->Qt};
+  double *own[] = {g->x,  g->p,  g->F,  g->x0, g->p0, g->F0,
+                   g->dx, g->dp, g->dF, g->Qt, g->lu};
   for (size_t i = 0; i < sizeof own / sizeof *own; ++i)
     free(own[i]);
   memset(g, 0, sizeof *g);
@@ -135,6 +161,9 @@ void sph_gpu_tl_jst_twin_step(const sph_gpu_tl_jst *g, int stages, double dt) {
       sph_gpu_stress_one(a, g);
     for (size_t a = 0; a < n; ++a)
       sph_gpu_rates_one(a, g);
+    if (g->lu)
+      for (size_t a = 0; a < n; ++a)
+        sph_gpu_jst_one(a, g);
     for (size_t a = 0; a < n; ++a)
       sph_gpu_combine_one(a, g, ca, cb, dt);
   }

@@ -44,10 +44,10 @@ command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,m
 echo "== 1. the device step against the CPU (tl-jst pF, clamped base)"
 run test_gpu_step
 rc=$?
-[ $rc = 0 ] && pass "device step = CPU (one step 1e-12, 200 steps 1e-9, repeatable)" ||
+[ $rc = 0 ] && pass "device step = CPU (one step 1e-12, 200 steps 1e-9, with and without JST, repeatable)" ||
   { [ $rc = 77 ] && fail "no device (SKIP above)" || fail "device step against the CPU (rc $rc)"; }
 
-echo "== 2. throughput: ~1M particles (55 x 330 x 55 column), TVD-RK2"
+echo "== 2. throughput: ~1M particles (55 x 330 x 55 column), pF TVD-RK2 + JST"
 t0=$(date +%s)
 run test_gpu_step --bench 55 && pass "bench 1M ($(( $(date +%s) - t0 )) s)" || fail "bench 1M"
 

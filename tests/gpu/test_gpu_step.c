@@ -2,9 +2,9 @@
  * jittered twisting column with its base clamped: after one step every
  * field within 1e-12 relative (the kernels are built with --fmad=false, so
  * products and sums round as the CPU's; pow in the stress may differ from
- * glibc's by an ulp), after 200 steps within 1e-9 (round-off carried
- * along), and two device runs equal to the bit. Exit 77 (ctest SKIP) when
- * there is no device or no CUDA build.
+ * glibc's by an ulp), with and without the JST term, after 200 steps
+ * within 1e-9 (round-off carried along), and two device runs equal to the
+ * bit. Exit 77 (ctest SKIP) when there is no device or no CUDA build.
  *   test_gpu_step                 the checks above, PASS/FAIL per line
  *   test_gpu_step --bench K       a K x 6K x K column (K = 55: ~1M
  *                                 particles): device particle-steps/s and
@@ -125,6 +125,9 @@ static int compare(const char *label, const char *method, int steps,
 static const char *const plain_rk2 =
     "{name: tl-jst, fields: pF, jst: {eps4_p: 0}, "
     "angular_momentum_projection: false, jst_projection: false}";
+static const char *const jst_rk2 =
+    "{name: tl-jst, fields: pF, jst: {eps4_p: 0.125}, "
+    "angular_momentum_projection: false, jst_projection: false}";
 static const char *const plain_rk3 =
     "{name: tl-jst, fields: pF, integrator: ssp-rk3, jst: {eps4_p: 0}, "
     "angular_momentum_projection: false, jst_projection: false}";
@@ -132,7 +135,7 @@ static const char *const plain_rk3 =
 /* particle-steps/s of the device on a k x 6k x k column */
 static int bench(int k) {
   double t0 = now();
-  sph_scene *s = column(plain_rk2, k, 6.0);
+  sph_scene *s = column(jst_rk2, k, 6.0);
   sph_sim *sim;
   sph_error err;
   if (!s || sph_sim_create(&sim, s, &err) != SPH_OK) {
@@ -185,6 +188,8 @@ int main(int argc, char **argv) {
     return bench(atoi(argv[2]));
   int fail = compare("one step, TVD-RK2", plain_rk2, 1, 1e-12);
   fail |= compare("one step, SSP-RK3", plain_rk3, 1, 1e-12);
+  fail |= compare("one step, TVD-RK2 + JST", jst_rk2, 1, 1e-12);
   fail |= compare("200 steps, TVD-RK2", plain_rk2, 200, 1e-9);
+  fail |= compare("200 steps, TVD-RK2 + JST", jst_rk2, 200, 1e-9);
   return fail ? 1 : 0;
 }

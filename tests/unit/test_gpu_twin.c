@@ -104,6 +104,18 @@ START_TEST(twin_ssp_rk3) {
 }
 END_TEST
 
+/* with the JST term on p (eq. 35-38): fourth order, and second and fourth */
+START_TEST(twin_jst) {
+  twin_equals_cpu("{name: tl-jst, fields: pF, jst: {eps4_p: 0.125}, "
+                  "angular_momentum_projection: false, jst_projection: false}",
+                  20);
+  twin_equals_cpu("{name: tl-jst, fields: pF, integrator: ssp-rk3, "
+                  "jst: {eps2_p: 0.1, eps4_p: 0.125}, "
+                  "angular_momentum_projection: false, jst_projection: false}",
+                  20);
+}
+END_TEST
+
 /* what the device step lacks is refused, naming the part */
 START_TEST(twin_refuses_missing_parts) {
   static const char *const methods[] = {
@@ -112,10 +124,11 @@ START_TEST(twin_refuses_missing_parts) {
       "angular_momentum_projection: false, jst_projection: false}",
       "{name: tl-jst, force: symmetric, jst: {eps4_p: 0}, "
       "angular_momentum_projection: false, jst_projection: false}",
-      "{name: ul-sph}"};
+      "{name: ul-sph}", "{name: tl-jst, angular_momentum_projection: false}"};
   static const char *const named[] = {"angular_momentum_projection", "pFJ",
-                                      "conservative", "method"};
-  for (int i = 0; i < 4; ++i) {
+                                      "conservative", "method",
+                                      "jst_projection"};
+  for (int i = 0; i < 5; ++i) {
     sph_scene *s = column(methods[i]);
     sph_sim *sim;
     sph_error err;
@@ -137,6 +150,7 @@ int main(void) {
   TCase *tc = tcase_create("twin");
   tcase_add_test(tc, twin_tvd_rk2);
   tcase_add_test(tc, twin_ssp_rk3);
+  tcase_add_test(tc, twin_jst);
   tcase_add_test(tc, twin_refuses_missing_parts);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
