@@ -25,10 +25,13 @@ pass() { echo "PASS $*"; }
 fail() { echo "FAIL $*"; fails=$((fails + 1)); }
 
 if [ $KIT = 1 ]; then
-  : "${K:?source .device/kit.sh first}"
+  K=$(cd "$(dirname "$0")/.." && pwd) # the kit's root: bin/ holds this script
+  # as kit.sh sets it: sph restarts itself through /proc/self/exe (the
+  # carried loader) unless the OpenMP wait policy is chosen
+  export GOMP_SPINCOUNT=${GOMP_SPINCOUNT:-1000}
   cudadir=
   for d in $(ldconfig -p 2>/dev/null | awk '/libcuda\.so\.1 /{print $NF}' | xargs -r dirname) \
-           /usr/local/nvidia/lib64 /usr/lib/x86_64-linux-gnu /usr/lib64 ${LD_LIBRARY_PATH//:/ }; do
+           /usr/local/nvidia/lib64 /usr/lib/x86_64-linux-gnu /usr/lib64 ${LD_LIBRARY_PATH:+${LD_LIBRARY_PATH//:/ }}; do
     [ -e "$d/libcuda.so.1" ] && { cudadir=$d; break; }
   done
   echo "libcuda.so.1: ${cudadir:-not found}"
