@@ -4,7 +4,9 @@
  * function of tl_jst_gpu_one.h that the twin calls in a loop: the stress
  * (Q = P L), the rates (a gather over the particle's neighbour slots in
  * their fixed order: no atomics), with the JST term a second gather over
- * the neighbours' L[p], and the Runge-Kutta combination with the clamp. Built
+ * the neighbours' L[p], the momentum projections (per-body sums over the
+ * CPU's 64 blocks, one thread each, added in block order by one thread: the
+ * CPU's order), and the Runge-Kutta combination with the clamp. Built
  * with --fmad=false, so that products and sums round as the CPU's do; only pow
  * in the stress may differ by an ulp from glibc's. */
 #include <cuda_runtime.h>
@@ -20,7 +22,7 @@ struct sph_gpu_step {
   sph_gpu_tl_jst d; /* device pointers */
   int stages;
   size_t bytes;
-  void *blocks[24];
+  void *blocks[32];
   int nblocks;
 };
 
@@ -48,6 +50,38 @@ __global__ void jst_kernel(sph_gpu_tl_jst g) {
   size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
   if (a < g.n)
     sph_gpu_jst_one(a, &g);
+}
+
+__global__ void finish_kernel(sph_gpu_tl_jst g) {
+  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
+  if (a < g.n)
+    sph_gpu_finish_one(a, &g);
+}
+
+__global__ void xmoment_kernel(sph_gpu_tl_jst g, double dt) {
+  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
+  if (a < g.n)
+    sph_gpu_xmoment_one(a, &g, dt);
+}
+
+/* one thread per block of the projection's sums: the CPU's blocks, each
+ * summed in particle order, then added in block order by one thread */
+__global__ void proj_block_kernel(sph_gpu_tl_jst g, const double *X,
+                                  const double *w, int b, int second) {
+  int k = (int)threadIdx.x;
+  if (k < SPH_PROJ_BLOCKS)
+    sph_gpu_proj_block_one(k, &g, X, w, b, second);
+}
+
+__global__ void proj_finish_kernel(sph_gpu_tl_jst g, int second) {
+  sph_gpu_proj_finish(&g, second);
+}
+
+__global__ void proj_apply_kernel(sph_gpu_tl_jst g, const double *X, double *w,
+                                  int b) {
+  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
+  if (a < g.n)
+    sph_gpu_proj_apply_one(a, &g, X, w, b);
 }
 
 __global__ void combine_kernel(sph_gpu_tl_jst g, double ca, double cb,
@@ -120,6 +154,17 @@ static sph_status create_arrays(sph_gpu_step *s, const sph_gpu_tl_jst *h,
     UP(lap, slots, double);
     UP(lu, 3 * n, double);
   }
+  d->d = NULL;
+  if (h->d)
+    UP(d, 3 * n, double);
+  d->amp = h->amp;
+  d->xmom = h->xmom;
+  d->nbodies = h->nbodies;
+  UP(V, n, double);
+  UP(body, n, int32_t);
+  UP(xm, 3 * n, double);
+  UP(part, 12 * SPH_PROJ_BLOCKS, double);
+  UP(coef, SPH_GPU_COEF, double);
   return SPH_OK;
 }
 
@@ -140,6 +185,18 @@ extern "C" sph_status sph_gpu_tl_jst_create(sph_gpu_step **out,
   return SPH_OK;
 }
 
+/* the projection of w about X, body by body (sph_momentum_projection) */
+static void project(const sph_gpu_tl_jst &g, unsigned blocks, const double *X,
+                    double *w) {
+  for (int b = 0; b < g.nbodies; ++b)
+    for (int second = 0; second < 2; ++second) {
+      proj_block_kernel<<<1, SPH_PROJ_BLOCKS>>>(g, X, w, b, second);
+      proj_finish_kernel<<<1, 1>>>(g, second);
+      if (second)
+        proj_apply_kernel<<<blocks, THREADS>>>(g, X, w, b);
+    }
+}
+
 extern "C" sph_status sph_gpu_tl_jst_advance(sph_gpu_step *s, double dt,
                                              long steps, sph_error *err) {
   const sph_gpu_tl_jst g = s->d;
@@ -151,8 +208,19 @@ extern "C" sph_status sph_gpu_tl_jst_advance(sph_gpu_step *s, double dt,
       sph_gpu_rk_coefficients(s->stages, k, &ca, &cb);
       stress_kernel<<<blocks, THREADS>>>(g);
       rates_kernel<<<blocks, THREADS>>>(g);
+      const double *X = g.x;
+      if (g.xmom && k > 0 && (g.amp || g.d)) {
+        xmoment_kernel<<<blocks, THREADS>>>(g, dt);
+        X = g.xm;
+      }
+      if (g.amp)
+        project(g, blocks, X, g.dp);
       if (g.lu)
         jst_kernel<<<blocks, THREADS>>>(g);
+      if (g.d)
+        project(g, blocks, X, g.d);
+      if (g.amp || g.lu)
+        finish_kernel<<<blocks, THREADS>>>(g);
       combine_kernel<<<blocks, THREADS>>>(g, ca, cb, dt);
     }
   }

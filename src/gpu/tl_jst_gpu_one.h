@@ -19,6 +19,7 @@
 #include "core/tensor.h"
 #include "materials/neo_hookean_law.h"
 #include "methods/common/pair_iact.h"
+#include "terms/momentum_projection.h"
 
 /* Plain arrays of the step, host or device memory alike: the reference
  * configuration (fixed for a total-Lagrangian method: the neighbour lists
@@ -38,7 +39,22 @@ typedef struct sph_gpu_tl_jst {
   double *Qt;                     /* (P L)^T per particle (9n) */
   double *lu;    /* L[p] for the JST term (3n), NULL without it */
   double c2, c4; /* JST: eps2 c_p h and eps4 c_p h^3 (seed 000 eq. 35) */
+  /* the momentum projections of eq. 45-49: of the force (amp) and of the
+   * JST term (d, its D(p), 3n, NULL without); about X^chi of eq. 45 (xm,
+   * 3n: x^n + dt / (2 rho0) (p^n + p*) in TVD-RK2's second stage when
+   * xmom, else x) */
+  int amp, xmom;
+  double *d, *xm;
+  const double *V;     /* reference volumes (n) */
+  const int32_t *body; /* body per particle (n) */
+  int nbodies;
+  double *part; /* SPH_PROJ_BLOCKS x 12 block sums */
+  double *coef; /* a body's sums and coefficients (SPH_GPU_COEF) */
 } sph_gpu_tl_jst;
+
+/* coef: 7 sums with the centroid, 12 sums, lambda, mu, and a flag (the
+ * body has volume) */
+enum { SPH_GPU_COEF = 26 };
 
 /* Q_a = P_a L_a, transposed, of the stress of F_a (compute_stress) */
 SPH_HD static inline void sph_gpu_stress_one(size_t a,
@@ -76,8 +92,9 @@ SPH_HD static inline void sph_gpu_rates_one(size_t a, const sph_gpu_tl_jst *g) {
   ref_iact_gradient_correct(G, g->L + 9 * a);
   for (int k = 0; k < 9; ++k)
     g->dF[9 * a + k] = G[k] * inv_rho0;
-  /* the clamp comes after the JST term's share (sph_gpu_jst_one) */
-  unsigned fix = g->fixed && !g->lu ? g->fixed[a] : 0u;
+  /* with projections or JST the clamp comes after them
+   * (sph_gpu_finish_one) */
+  unsigned fix = g->fixed && !g->lu && !g->amp ? g->fixed[a] : 0u;
   for (int c = 0; c < 3; ++c) {
     g->dp[3 * a + c] = (fix & (1u << c)) ? 0.0 : f[c];
     g->dx[3 * a + c] = pa[c] * inv_rho0;
@@ -88,8 +105,8 @@ SPH_HD static inline void sph_gpu_rates_one(size_t a, const sph_gpu_tl_jst *g) {
 }
 
 /* The JST term of particle a, once every L[p] is in (jst_rates):
- * D = c2 L[p] - c4 L[L[p]] (D = c2 L[p] when c4 = 0), dp += D, then the
- * clamp */
+ * D = c2 L[p] - c4 L[L[p]] (D = c2 L[p] when c4 = 0), into d for the
+ * projection, else added to dp */
 SPH_HD static inline void sph_gpu_jst_one(size_t a, const sph_gpu_tl_jst *g) {
   const double *la = g->lu + 3 * a;
   double d[3];
@@ -107,12 +124,75 @@ SPH_HD static inline void sph_gpu_jst_one(size_t a, const sph_gpu_tl_jst *g) {
     for (int c = 0; c < 3; ++c)
       d[c] = g->c2 * la[c];
   }
+  for (int c = 0; c < 3; ++c) {
+    if (g->d)
+      g->d[3 * a + c] = d[c];
+    else
+      g->dp[3 * a + c] += d[c];
+  }
+}
+
+/* After the projections and JST: dp += D (projected), then the clamp */
+SPH_HD static inline void sph_gpu_finish_one(size_t a,
+                                             const sph_gpu_tl_jst *g) {
   unsigned fix = g->fixed ? g->fixed[a] : 0u;
   for (int c = 0; c < 3; ++c) {
-    g->dp[3 * a + c] += d[c];
+    if (g->d)
+      g->dp[3 * a + c] += g->d[3 * a + c];
     if (fix & (1u << c))
       g->dp[3 * a + c] = 0.0;
   }
+}
+
+/* X^chi of eq. 45 in TVD-RK2's second stage (tl_jst_rhs) */
+SPH_HD static inline void sph_gpu_xmoment_one(size_t a, const sph_gpu_tl_jst *g,
+                                              double dt) {
+  for (int c = 0; c < 3; ++c)
+    g->xm[3 * a + c] =
+        g->x0[3 * a + c] +
+        0.5 * dt * (g->p0[3 * a + c] + g->p[3 * a + c]) / g->rho0[a];
+}
+
+/* Block k's sums of body b for the projection of w about X: 7 (xc NULL) or
+ * 12 (about the centroid in coef + 1) */
+SPH_HD static inline void sph_gpu_proj_block_one(int k, const sph_gpu_tl_jst *g,
+                                                 const double *X,
+                                                 const double *w, int b,
+                                                 int second) {
+  double *s = g->part + 12 * k;
+  for (int c = 0; c < 12; ++c)
+    s[c] = 0.0;
+  if (second && !g->coef[25])
+    return;
+  size_t lo, hi;
+  sph_proj_block_range(g->n, k, &lo, &hi);
+  if (lo < hi)
+    sph_proj_block_sums(lo, hi, g->V, X, g->body, b, w,
+                        second ? g->coef + 1 : NULL, s);
+}
+
+/* the blocks added in order: the centroid (first), or lambda and mu
+ * (second) */
+SPH_HD static inline void sph_gpu_proj_finish(const sph_gpu_tl_jst *g,
+                                              int second) {
+  double *q = g->coef;
+  if (!second) {
+    sph_proj_add_blocks(g->part, 7, q);
+    q[25] = sph_proj_centroid(q);
+  } else if (q[25]) {
+    sph_proj_add_blocks(g->part, 12, q + 7);
+    sph_proj_coefficients(q, q + 7, q + 19, q + 22);
+  }
+}
+
+/* w_a corrected, for a particle of body b when the body has volume */
+SPH_HD static inline void sph_gpu_proj_apply_one(size_t a,
+                                                 const sph_gpu_tl_jst *g,
+                                                 const double *X, double *w,
+                                                 int b) {
+  const double *q = g->coef;
+  if (q[25] && g->body[a] == b)
+    sph_proj_apply_one(a, X, q + 1, q + 19, q + 22, w);
 }
 
 /* y0 = y for particle a's x, p and F */

@@ -16,7 +16,6 @@
 
 /* the parts of a tl-jst sim the device step does not have, or NULL */
 static const char *unsupported(const sph_sim *sim, const tl_jst *m) {
-  sph_error scratch;
   if (strcmp(sim->method->name, "tl-jst") != 0)
     return "the method (only tl-jst has a device step)";
   if (m->fields != TL_JST_PF)
@@ -28,16 +27,11 @@ static const char *unsupported(const sph_sim *sim, const tl_jst *m) {
   for (size_t a = 0; a < m->ref.n; ++a)
     if (m->ref.mat[a]->ops != &sph_neo_hookean_ops)
       return "materials other than neo-hookean";
-  int jst_projection = 1;
-  sph_node *opt = sim->scene->method;
-  if (sph_node_child(opt, "jst_projection"))
-    sph_node_get_bool(opt, "jst_projection", 0, 1, &jst_projection, &scratch);
   for (int i = 0; i < sim->nterms; ++i) {
     const char *name = sim->terms[i].ops->name;
-    if (strcmp(name, "jst_dissipation_p") == 0 && jst_projection)
-      return "jst_projection (the JST term without it has one)";
     if (strcmp(name, "essential_bc") != 0 &&
-        strcmp(name, "jst_dissipation_p") != 0)
+        strcmp(name, "jst_dissipation_p") != 0 &&
+        strcmp(name, "angular_momentum_projection") != 0)
       return name;
   }
   for (size_t k = 0; k < sim->scene->nboundaries; ++k)
@@ -52,16 +46,24 @@ static void *host_alloc(size_t count, size_t size, int *ok) {
   return p;
 }
 
-/* bit c of fixed[a]: the clamp zeroes dp_c of particle a (the terms'
- * rates on a rate of ones) */
+/* bit c of fixed[a]: the clamp zeroes dp_c of particle a (the boundary
+ * term's rates on a rate of ones) */
 static sph_status clamp_mask(sph_sim *sim, const tl_jst *m,
                              unsigned char *fixed, double *ones,
                              sph_error *err) {
   size_t n = m->ref.n;
   for (size_t i = 0; i < 3 * n; ++i)
     ones[i] = 1.0;
-  sph_stage s = {.t = sim->t, .x = m->x, .p = m->p, .F = m->F, .dp = ones};
-  SPH_TRY(sph_sim_terms_rates(sim, &s, err));
+  sph_stage s = {.t = sim->t,
+                 .x = m->x,
+                 .x_moment = m->x,
+                 .p = m->p,
+                 .F = m->F,
+                 .dp = ones};
+  /* the boundary term alone: the projections would move the ones too */
+  for (int i = 0; i < sim->nterms; ++i)
+    if (strcmp(sim->terms[i].ops->name, "essential_bc") == 0)
+      SPH_TRY(sim->terms[i].ops->rates(&sim->terms[i], sim, &s, err));
   for (size_t a = 0; a < n; ++a) {
     fixed[a] = 0;
     for (int c = 0; c < 3; ++c)
@@ -118,6 +120,16 @@ sph_status sph_gpu_tl_jst_host_create(sph_sim *sim, sph_gpu_tl_jst *g,
   memcpy(g->x, m->x, 3 * n * sizeof(double));
   memcpy(g->p, m->p, 3 * n * sizeof(double));
   memcpy(g->F, m->F, 9 * n * sizeof(double));
+  for (int i = 0; i < sim->nterms; ++i)
+    g->amp |=
+        strcmp(sim->terms[i].ops->name, "angular_momentum_projection") == 0;
+  g->xmom = *stages == 2;
+  g->V = sim->ps->field[SPH_FIELD_VOLUME0];
+  g->body = sim->ps->body;
+  g->nbodies = (int)sim->scene->nbodies;
+  g->xm = host_alloc(3 * n, sizeof(double), &ok);
+  g->part = host_alloc(12 * SPH_PROJ_BLOCKS, sizeof(double), &ok);
+  g->coef = host_alloc(SPH_GPU_COEF, sizeof(double), &ok);
   if (m->lu_p) { /* the JST term on p (tl_jst.c's setup_terms) */
     double e2 = 0.0, e4 = 0.0;
     sph_node *jst = sph_node_child(sim->scene->method, "jst");
@@ -128,6 +140,11 @@ sph_status sph_gpu_tl_jst_host_create(sph_sim *sim, sph_gpu_tl_jst *g,
     g->c4 = e4 * cp * h * h * h;
     g->lap = m->lap;
     g->lu = host_alloc(3 * n, sizeof(double), &ok);
+    int proj = 1;
+    if (sph_node_child(sim->scene->method, "jst_projection"))
+      sph_node_get_bool(sim->scene->method, "jst_projection", 0, 1, &proj, err);
+    if (proj)
+      g->d = host_alloc(3 * n, sizeof(double), &ok);
     if (!ok) {
       sph_gpu_tl_jst_host_destroy(g);
       return sph_error_set(err, SPH_ERR_NOMEM, "device step host arrays");
@@ -143,11 +160,24 @@ void sph_gpu_tl_jst_host_destroy(sph_gpu_tl_jst *g) {
   free((void *)g->mu);
   free((void *)g->kappa);
   free((void *)g->fixed);
-  double *own[] = {g->x,  g->p,  g->F,  g->x0, g->p0, g->F0,
-                   g->dx, g->dp, g->dF, g->Qt, g->lu};
+  double *own[] = {g->x,  g->p,  g->F,  g->x0, g->p0, g->F0,   g->dx,  g->dp,
+                   g->dF, g->Qt, g->lu, g->d,  g->xm, g->part, g->coef};
   for (size_t i = 0; i < sizeof own / sizeof *own; ++i)
     free(own[i]);
   memset(g, 0, sizeof *g);
+}
+
+/* the projection of w about X, body by body (sph_momentum_projection) */
+static void project(const sph_gpu_tl_jst *g, const double *X, double *w) {
+  for (int b = 0; b < g->nbodies; ++b)
+    for (int second = 0; second < 2; ++second) {
+      for (int k = 0; k < SPH_PROJ_BLOCKS; ++k)
+        sph_gpu_proj_block_one(k, g, X, w, b, second);
+      sph_gpu_proj_finish(g, second);
+      if (second)
+        for (size_t a = 0; a < g->n; ++a)
+          sph_gpu_proj_apply_one(a, g, X, w, b);
+    }
 }
 
 void sph_gpu_tl_jst_twin_step(const sph_gpu_tl_jst *g, int stages, double dt) {
@@ -161,9 +191,22 @@ void sph_gpu_tl_jst_twin_step(const sph_gpu_tl_jst *g, int stages, double dt) {
       sph_gpu_stress_one(a, g);
     for (size_t a = 0; a < n; ++a)
       sph_gpu_rates_one(a, g);
+    const double *X = g->x;
+    if (g->xmom && k > 0 && (g->amp || g->d)) {
+      for (size_t a = 0; a < n; ++a)
+        sph_gpu_xmoment_one(a, g, dt);
+      X = g->xm;
+    }
+    if (g->amp)
+      project(g, X, g->dp);
     if (g->lu)
       for (size_t a = 0; a < n; ++a)
         sph_gpu_jst_one(a, g);
+    if (g->d)
+      project(g, X, g->d);
+    if (g->amp || g->lu)
+      for (size_t a = 0; a < n; ++a)
+        sph_gpu_finish_one(a, g);
     for (size_t a = 0; a < n; ++a)
       sph_gpu_combine_one(a, g, ca, cb, dt);
   }

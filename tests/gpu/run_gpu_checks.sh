@@ -44,13 +44,14 @@ else
 fi
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
 
-echo "== 1. the device step against the CPU (tl-jst pF, clamped base)"
-run test_gpu_step
+echo "== 1. the device step against the CPU (tl-jst pF, clamped base; plain, JST,"
+echo "      the shipped column's JST + projections), the shipped column's energy"
+run test_gpu_step --scenes "$SCENES"
 rc=$?
-[ $rc = 0 ] && pass "device step = CPU (one step 1e-12, 200 steps 1e-9, with and without JST, repeatable)" ||
+[ $rc = 0 ] && pass "device step = CPU (one step 1e-12, 200 steps 1e-9, energy 1e-6, repeatable)" ||
   { [ $rc = 77 ] && fail "no device (SKIP above)" || fail "device step against the CPU (rc $rc)"; }
 
-echo "== 2. throughput: ~1M particles (55 x 330 x 55 column), pF TVD-RK2 + JST"
+echo "== 2. throughput: ~1M particles (55 x 330 x 55 column), the shipped column's method"
 t0=$(date +%s)
 run test_gpu_step --bench 55 && pass "bench 1M ($(( $(date +%s) - t0 )) s)" || fail "bench 1M"
 

@@ -5,7 +5,12 @@
  * glibc's by an ulp), with and without the JST term, after 200 steps
  * within 1e-9 (round-off carried along), and two device runs equal to the
  * bit. Exit 77 (ctest SKIP) when there is no device or no CUDA build.
- *   test_gpu_step                 the checks above, PASS/FAIL per line
+ * With the JST projection and the angular momentum projection (the shipped
+ * column's method) the same; and the shipped twisting column's energies
+ * after 500 steps within 1e-6 relative of the CPU's.
+ *   test_gpu_step [--scenes DIR]  the checks above, PASS/FAIL per line
+ *   test_gpu_step --twin ...      the host twin in the device's place: the
+ *                                 harness checked without a GPU
  *   test_gpu_step --bench K       a K x 6K x K column (K = 55: ~1M
  *                                 particles): device particle-steps/s and
  *                                 bytes per particle, CPU for one step */
@@ -20,6 +25,45 @@
 #include "solver/sim.h"
 
 #define SKIP 77
+
+/* --twin: the host twin stands in for the device (the harness checked on a
+ * machine without a GPU; its figures are then exact) */
+static int use_twin;
+typedef struct stepper {
+  sph_gpu_step *d;
+  sph_gpu_tl_jst *h;
+  int stages;
+} stepper;
+
+static sph_status st_create(stepper *s, sph_gpu_tl_jst *h, int stages,
+                            sph_error *err) {
+  s->h = h;
+  s->stages = stages;
+  s->d = NULL;
+  return use_twin ? SPH_OK : sph_gpu_tl_jst_create(&s->d, h, stages, err);
+}
+
+static sph_status st_advance(stepper *s, double dt, long steps,
+                             sph_error *err) {
+  if (!use_twin)
+    return sph_gpu_tl_jst_advance(s->d, dt, steps, err);
+  for (long i = 0; i < steps; ++i)
+    sph_gpu_tl_jst_twin_step(s->h, s->stages, dt);
+  return SPH_OK;
+}
+
+static sph_status st_download(stepper *s, double *x, double *p, double *F,
+                              sph_error *err) {
+  if (!use_twin)
+    return sph_gpu_tl_jst_download(s->d, x, p, F, err);
+  size_t n = s->h->n;
+  if (x != s->h->x) {
+    memcpy(x, s->h->x, 3 * n * sizeof *x);
+    memcpy(p, s->h->p, 3 * n * sizeof *p);
+    memcpy(F, s->h->F, 9 * n * sizeof *F);
+  }
+  return SPH_OK;
+}
 
 static double now(void) {
   struct timespec ts;
@@ -73,28 +117,28 @@ static int compare(const char *label, const char *method, int steps,
     printf("FAIL %s: set-up\n", label);
     return 1;
   }
-  sph_gpu_tl_jst h;
-  int stages;
-  sph_gpu_step *d[2] = {NULL, NULL};
-  int bad = sph_gpu_tl_jst_host_create(sim, &h, &stages, &err) != SPH_OK;
+  sph_gpu_tl_jst h[2];
+  int stages, bad = 0;
+  stepper d[2];
   for (int r = 0; r < 2 && !bad; ++r)
-    bad = sph_gpu_tl_jst_create(&d[r], &h, stages, &err) != SPH_OK;
+    bad = sph_gpu_tl_jst_host_create(sim, &h[r], &stages, &err) != SPH_OK ||
+          st_create(&d[r], &h[r], stages, &err) != SPH_OK;
   double dt = 0.5 * sph_sim_stable_dt(sim);
   for (int k = 0; k < steps && !bad; ++k)
     bad = sph_sim_step(sim, dt, &err) != SPH_OK;
   for (int r = 0; r < 2 && !bad; ++r)
-    bad = sph_gpu_tl_jst_advance(d[r], dt, steps, &err) != SPH_OK;
+    bad = st_advance(&d[r], dt, steps, &err) != SPH_OK;
   if (bad) {
     printf("FAIL %s: %s\n", label, err.message);
     return 1;
   }
-  size_t n = h.n;
+  size_t n = h[0].n;
   double *y[2][3];
   for (int r = 0; r < 2; ++r) {
     y[r][0] = malloc(3 * n * sizeof(double));
     y[r][1] = malloc(3 * n * sizeof(double));
     y[r][2] = malloc(9 * n * sizeof(double));
-    sph_gpu_tl_jst_download(d[r], y[r][0], y[r][1], y[r][2], &err);
+    st_download(&d[r], y[r][0], y[r][1], y[r][2], &err);
   }
   sph_state_array arr[8];
   int count = sim->method->state(sim, arr), fail = 0;
@@ -114,9 +158,9 @@ static int compare(const char *label, const char *method, int steps,
   for (int r = 0; r < 2; ++r) {
     for (int f = 0; f < 3; ++f)
       free(y[r][f]);
-    sph_gpu_tl_jst_destroy(d[r]);
+    sph_gpu_tl_jst_destroy(d[r].d);
+    sph_gpu_tl_jst_host_destroy(&h[r]);
   }
-  sph_gpu_tl_jst_host_destroy(&h);
   sph_sim_destroy(sim);
   sph_scene_destroy(s);
   return fail;
@@ -132,10 +176,67 @@ static const char *const plain_rk3 =
     "{name: tl-jst, fields: pF, integrator: ssp-rk3, jst: {eps4_p: 0}, "
     "angular_momentum_projection: false, jst_projection: false}";
 
+/* The shipped twisting column (scenes/twisting_column.yaml: JST with its
+ * projection, the angular momentum projection, TVD-RK2, clamped base)
+ * `steps` steps on the CPU and the device: kinetic and strain energy of
+ * the device's state (copied into the CPU's method) within 1e-6 relative
+ * of the CPU's */
+static int shipped_energy(const char *scenes, int steps) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/twisting_column.yaml", scenes);
+  sph_scene *s = NULL;
+  sph_sim *sim;
+  sph_error err;
+  if (sph_scene_load(&s, path, NULL, 0, &err) != SPH_OK ||
+      sph_sim_create(&sim, s, &err) != SPH_OK) {
+    printf("FAIL shipped twisting column: %s\n", err.message);
+    return 1;
+  }
+  sph_gpu_tl_jst h;
+  int stages;
+  stepper d = {0};
+  double dt = 0.5 * sph_sim_stable_dt(sim), k0, s0, k1, s1;
+  int bad = sph_gpu_tl_jst_host_create(sim, &h, &stages, &err) != SPH_OK ||
+            st_create(&d, &h, stages, &err) != SPH_OK ||
+            st_advance(&d, dt, steps, &err) != SPH_OK;
+  for (int k = 0; k < steps && !bad; ++k)
+    bad = sph_sim_step(sim, dt, &err) != SPH_OK;
+  if (bad) {
+    printf("FAIL shipped twisting column: %s\n", err.message);
+    return 1;
+  }
+  sim->method->energy(sim, &k0, &s0);
+  sph_state_array arr[8];
+  int count = sim->method->state(sim, arr);
+  double *y[3] = {NULL, NULL, NULL};
+  for (int i = 0; i < count; ++i) {
+    if (strcmp(arr[i].name, "x") == 0)
+      y[0] = arr[i].data;
+    else if (strcmp(arr[i].name, "p") == 0)
+      y[1] = arr[i].data;
+    else if (strcmp(arr[i].name, "F") == 0)
+      y[2] = arr[i].data;
+  }
+  st_download(&d, y[0], y[1], y[2], &err);
+  sim->method->energy(sim, &k1, &s1);
+  double ek = fabs(k1 - k0) / fabs(k0), es = fabs(s1 - s0) / fabs(s0);
+  int fail = !(ek <= 1e-6 && es <= 1e-6);
+  printf("shipped twisting column, %d steps of %.3g s (t = %.4g s): kinetic "
+         "CPU %.10g device %.10g (%.2g), strain CPU %.10g device %.10g "
+         "(%.2g)\n%s shipped twisting column: energies within 1e-6 "
+         "relative\n",
+         steps, dt, steps * dt, k0, k1, ek, s0, s1, es, fail ? "FAIL" : "PASS");
+  sph_gpu_tl_jst_destroy(d.d);
+  sph_gpu_tl_jst_host_destroy(&h);
+  sph_sim_destroy(sim);
+  sph_scene_destroy(s);
+  return fail;
+}
+
 /* particle-steps/s of the device on a k x 6k x k column */
 static int bench(int k) {
   double t0 = now();
-  sph_scene *s = column(jst_rk2, k, 6.0);
+  sph_scene *s = column("{name: tl-jst}", k, 6.0);
   sph_sim *sim;
   sph_error err;
   if (!s || sph_sim_create(&sim, s, &err) != SPH_OK) {
@@ -179,17 +280,33 @@ static int bench(int k) {
 
 int main(int argc, char **argv) {
   char why[256];
-  if (sph_gpu_probe(why, sizeof why) <= 0) {
+  if (argc > 1 && strcmp(argv[1], "--twin") == 0) {
+    use_twin = 1;
+    --argc;
+    ++argv;
+    printf("the host twin stands in for the device\n");
+  } else if (sph_gpu_probe(why, sizeof why) <= 0) {
     printf("SKIP: %s\n", why);
     return SKIP;
   }
-  printf("device: %s\n", why);
+  if (!use_twin)
+    printf("device: %s\n", why);
   if (argc == 3 && strcmp(argv[1], "--bench") == 0)
-    return bench(atoi(argv[2]));
+    return use_twin ? 2 : bench(atoi(argv[2]));
+  const char *scenes = argc == 3 && strcmp(argv[1], "--scenes") == 0
+                           ? argv[2]
+                           : SPH_SOURCE_DIR "/scenes";
   int fail = compare("one step, TVD-RK2", plain_rk2, 1, 1e-12);
   fail |= compare("one step, SSP-RK3", plain_rk3, 1, 1e-12);
   fail |= compare("one step, TVD-RK2 + JST", jst_rk2, 1, 1e-12);
   fail |= compare("200 steps, TVD-RK2", plain_rk2, 200, 1e-9);
   fail |= compare("200 steps, TVD-RK2 + JST", jst_rk2, 200, 1e-9);
+  fail |= compare("one step, the shipped column's method", "{name: tl-jst}", 1,
+                  1e-12);
+  fail |= compare("one step, SSP-RK3 with projections",
+                  "{name: tl-jst, integrator: ssp-rk3}", 1, 1e-12);
+  fail |= compare("200 steps, the shipped column's method", "{name: tl-jst}",
+                  200, 1e-9);
+  fail |= shipped_energy(scenes, 500);
   return fail ? 1 : 0;
 }
