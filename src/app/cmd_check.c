@@ -60,6 +60,8 @@ static int print_device(const sph_scene *s, sph_sim *sim) {
   sph_status st = sph_device_plan(sim, plan, sizeof plan, &err);
   printf("device     %s\n%s", s->device == SPH_DEVICE_CUDA ? "cuda" : "cpu",
          plan);
+  if (st == SPH_OK)
+    st = sph_device_attach(sim, &err);
   sph_status sa = sph_device_available(s, &avail);
   if (st == SPH_OK && sa == SPH_OK)
     return SPH_EXIT_OK;

@@ -55,6 +55,24 @@ sph_status sph_gpu_tl_jst_download(sph_gpu_step *s, double *x, double *p,
 size_t sph_gpu_tl_jst_bytes(const sph_gpu_step *s);
 void sph_gpu_tl_jst_destroy(sph_gpu_step *s);
 
+/* ---- a run's step on the device (device_run.c) ---- */
+
+typedef struct sph_device_run sph_device_run;
+
+/* 1 when SPH_DEVICE_TWIN=1: the host twin stands in for the device (tests
+ * on machines without a GPU). */
+int sph_device_twin(void);
+
+/* The device step for sim (refused as sph_gpu_tl_jst_host_create refuses);
+ * the device is set up at the first step, from the state the host holds
+ * then (after a checkpoint's). */
+sph_status sph_device_run_create(struct sph_sim *sim, sph_device_run **out,
+                                 sph_error *err);
+/* One step of dt on the device, x, p and F copied back to the method's
+ * arrays. */
+sph_status sph_device_run_step(sph_device_run *r, double dt, sph_error *err);
+void sph_device_run_destroy(sph_device_run *r);
+
 #ifdef __cplusplus
 }
 #endif

@@ -21,9 +21,24 @@ sph_status sph_device_available(const sph_scene *scene, sph_error *err) {
   if (scene->device != SPH_DEVICE_CUDA)
     return SPH_OK;
   char why[256];
-  if (sph_gpu_probe(why, sizeof why) > 0)
+  if (sph_device_twin() || sph_gpu_probe(why, sizeof why) > 0)
     return SPH_OK;
   return refuse(scene, err, why);
+}
+
+sph_status sph_device_attach(sph_sim *sim, sph_error *err) {
+  if (sim->scene->device != SPH_DEVICE_CUDA)
+    return SPH_OK;
+  char plan[2048];
+  SPH_TRY(sph_device_plan(sim, plan, sizeof plan, err));
+  sph_error e;
+  sph_error_clear(&e);
+  if (sph_device_run_create(sim, &sim->device, &e) == SPH_OK)
+    return SPH_OK;
+  /* the configuration the device step lacks, at the device key */
+  char why[sizeof e.message + 64];
+  snprintf(why, sizeof why, "%s: %s", sim->method->name, e.message);
+  return refuse(sim->scene, err, why);
 }
 
 /* one line "  KIND NAME  WHERE" into buf at *used */

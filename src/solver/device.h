@@ -20,4 +20,10 @@ sph_status sph_device_available(const sph_scene *scene, sph_error *err);
 sph_status sph_device_plan(const sph_sim *sim, char *buf, size_t size,
                            sph_error *err);
 
+/* With `device: cuda`: sph_device_plan, then the method's device step set
+ * up in sim->device (its configuration refused at the device key, e.g.
+ * "tl-jst: no device step for tl-jst fields pFJ and pFHJ (only pF)").
+ * Nothing for a CPU scene. */
+sph_status sph_device_attach(sph_sim *sim, sph_error *err);
+
 #endif

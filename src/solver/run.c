@@ -69,10 +69,8 @@ sph_status sph_run_open(sph_run **out, const sph_scene *scene,
   sph_status st = sph_device_available(scene, err);
   if (st == SPH_OK)
     st = sph_sim_create(&run->sim, scene, err);
-  if (st == SPH_OK && scene->device != SPH_DEVICE_CPU) {
-    char plan[2048];
-    st = sph_device_plan(run->sim, plan, sizeof plan, err);
-  }
+  if (st == SPH_OK)
+    st = sph_device_attach(run->sim, err);
   if (st == SPH_OK && !run->opt.no_files) /* no frames without files */
     st = sph_png_check(run->sim, err);
   if (st == SPH_OK)

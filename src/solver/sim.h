@@ -118,6 +118,8 @@ typedef struct sph_timer {
 
 struct sph_sim {
   const sph_scene *scene;
+  /* the step on the device (`device: cuda`, gpu/device_run.c), or NULL */
+  struct sph_device_run *device;
   const sph_method_ops *method;
   void *method_data;
   sph_particles *ps;

@@ -73,6 +73,7 @@ const sph_term_ops angular_momentum_projection_term_ops = {
     .name = "angular_momentum_projection",
     .reference = "seed 000 sec. 6 eq. 45-48",
     .distributed = 1,
+    .gpu = 1,
     .rates = projection_rates,
 };
 

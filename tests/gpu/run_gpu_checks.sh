@@ -1,7 +1,8 @@
 #!/bin/bash
 # Every GPU check of sph (docs/gpu.md) in one run: builds nothing, prints
-# figures and PASS/FAIL per check, exit 0 when all passed. About 2-4 minutes
-# on an H100/H200 (the 1M-particle set-up on the CPU is most of it).
+# figures and PASS/FAIL per check, exit 0 when all passed. Meant to finish
+# in about 3-5 minutes on an H100/H200 (the CPU's set-up of the 1M- and
+# 384k-particle columns and the CPU's own twisting column run are most of it).
 #
 #   tests/gpu/run_gpu_checks.sh [BUILD_DIR]        (default: build)
 #   tests/gpu/run_gpu_checks.sh --kit              on a lent device machine
@@ -55,21 +56,49 @@ echo "== 2. throughput: ~1M particles (55 x 330 x 55 column), the shipped column
 t0=$(date +%s)
 run test_gpu_step --bench 55 && pass "bench 1M ($(( $(date +%s) - t0 )) s)" || fail "bench 1M"
 
-echo "== 3. sph run --device cuda: refused, exit 2, nothing written, until the"
-echo "      run loop drives the device step (docs/gpu.md 'Not yet')"
-out=$(mktemp -d)/o
-msg=$(run sph run "$SCENES/twisting_column.yaml" --device cuda --out "$out" --quiet 2>&1)
+# kinetic, strain and total energy (columns 2-4) of two energy.csv files:
+# each column's largest difference relative to its largest |value| within
+# tol; prints the worst
+energy_close() {
+  awk -F, -v tol="$3" '
+    NR == FNR { if (FNR > 1) for (c = 2; c <= 4; ++c) v[FNR, c] = $c; next }
+    FNR > 1 { rows++
+      for (c = 2; c <= 4; ++c) { d = v[FNR, c] - $c; m = $c
+        if (d < 0) d = -d; if (m < 0) m = -m
+        if (d > dif[c]) dif[c] = d; if (m > big[c]) big[c] = m } }
+    END { r = 0; for (c = 2; c <= 4; ++c) { q = big[c] > 0 ? dif[c] / big[c] : dif[c]; if (q > r) r = q }
+      printf "%d rows, energies differ by %.3g relative\n", rows, r
+      exit !(rows > 1 && r <= tol) }' "$1" "$2"
+}
+verdict() { grep -h "verdict" "$1" | tail -1; }
+
+echo "== 3. sph run --device cuda: the shipped twisting column to its end (0.3 s)"
+echo "      against the CPU's run: verdict and energy.csv within 1e-6 relative"
+o=$(mktemp -d)
+run sph run "$SCENES/twisting_column.yaml" --set output.png=false --out "$o/cpu" >"$o/cpu.log" 2>&1
+run sph run "$SCENES/twisting_column.yaml" --set output.png=false --device cuda --out "$o/gpu" >"$o/gpu.log" 2>&1
+rc=$?
+echo "CPU: $(verdict "$o/cpu.log")"
+echo "GPU: $(verdict "$o/gpu.log")"
+[ $rc = 0 ] && [ "$(verdict "$o/cpu.log" | cut -d'(' -f1)" = "$(verdict "$o/gpu.log" | cut -d'(' -f1)" ] &&
+  energy_close "$o/cpu/energy.csv" "$o/gpu/energy.csv" 1e-6 &&
+  pass "twisting column on the GPU: the CPU's verdict and energies" ||
+  { tail -3 "$o/gpu.log"; fail "twisting column on the GPU (rc $rc)"; }
+
+echo "== 4. sph run --device cuda at 384,000 particles (40 x 240 x 40), 0.002 s"
+run sph run "$SCENES/twisting_column.yaml" --set output.png=false --device cuda \
+  --set 'bodies.0.particles.count=[40,240,40]' --set time.end=0.002 --set output.every=0.001 \
+  --out "$o/big" >"$o/big.log" 2>&1 && pass "384k on the GPU: $(verdict "$o/big.log")" ||
+  { tail -3 "$o/big.log"; fail "384k on the GPU"; }
+
+echo "== 5. refusals: a method without a GPU path, exit 2, nothing written"
+msg=$(run sph run "$SCENES/colliding_rings.yaml" --device cuda --out "$o/rings" 2>&1)
 rc=$?
 echo "$msg"
-if [ $rc = 2 ] && [ ! -e "$out" ] && echo "$msg" | grep -q "no GPU path"; then
-  pass "--device cuda refused with the reason, exit 2, nothing written"
-else
-  fail "--device cuda: rc $rc, folder $( [ -e "$out" ] && echo written || echo absent)"
-fi
-msg=$(run sph check "$SCENES/twisting_column.yaml" --device cuda 2>&1 | tail -6)
-echo "$msg"
-echo "$msg" | grep -q "method tl-jst" && pass "sph check --device cuda lists where each part runs" ||
-  fail "sph check --device cuda"
+[ $rc = 2 ] && [ ! -e "$o/rings" ] && echo "$msg" | grep -q "no GPU path" &&
+  pass "ul-sph --device cuda refused" || fail "ul-sph --device cuda: rc $rc"
+run sph check "$SCENES/twisting_column.yaml" --device cuda | tail -5
+rm -rf "$o"
 
 echo "== $([ $fails = 0 ] && echo "ALL PASS" || echo "$fails FAILED")"
 [ $fails = 0 ]
