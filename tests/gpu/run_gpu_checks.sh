@@ -85,6 +85,24 @@ echo "GPU: $(verdict "$o/gpu.log")"
   pass "twisting column on the GPU: the CPU's verdict and energies" ||
   { tail -3 "$o/gpu.log"; fail "twisting column on the GPU (rc $rc)"; }
 
+echo "== 3b. the other shipped scenes the device step covers, 200 steps each:"
+echo "      energy.csv within 1e-6 relative of the CPU's"
+for sc in bending_column column_energy spinning_cube tensile_cube twisting_column_extreme; do
+  f=$SCENES/$sc.yaml
+  plan=$(run sph check "$f")
+  dt=$(echo "$plan" | sed -n 's/.*first dt \([0-9.e+-]*\) s.*/\1/p' | head -1)
+  tend=$(echo "$plan" | sed -n 's/.*time *end \([0-9.e+-]*\) s.*/\1/p' | head -1)
+  end=$(awk -v d="$dt" -v t="$tend" 'BEGIN { e = 200 * d; if (t < e) e = t; printf "%.6g", e }')
+  every=$(awk -v e="$end" 'BEGIN { printf "%.6g", e / 4 }')
+  sets=(--set output.png=false --set time.end=$end --set output.every=$every)
+  run sph run "$f" "${sets[@]}" --out "$o/c_$sc" >"$o/c_$sc.log" 2>&1
+  run sph run "$f" "${sets[@]}" --device cuda --out "$o/g_$sc" >"$o/g_$sc.log" 2>&1
+  rc=$?
+  echo "$sc: CPU $(verdict "$o/c_$sc.log"); GPU $(verdict "$o/g_$sc.log")"
+  [ $rc = 0 ] && energy_close "$o/c_$sc/energy.csv" "$o/g_$sc/energy.csv" 1e-6 &&
+    pass "$sc on the GPU" || { tail -2 "$o/g_$sc.log"; fail "$sc on the GPU (rc $rc)"; }
+done
+
 echo "== 4. sph run --device cuda at 384,000 particles (40 x 240 x 40), 0.002 s"
 run sph run "$SCENES/twisting_column.yaml" --set output.png=false --device cuda \
   --set 'bodies.0.particles.count=[40,240,40]' --set time.end=0.002 --set output.every=0.001 \
