@@ -5,6 +5,9 @@
 #   --with-fuzz     also install clang with libFuzzer and the sanitizer
 #                   runtimes, LLVM's OpenMP and symbolizer
 #                   (tests/fuzz/run_fuzz.sh)
+#   --with-cuda     also install Debian's nvidia-cuda-toolkit (nvcc, from the
+#                   non-free component) unless an nvcc is already there (on
+#                   PATH or /usr/local/cuda/bin): the GPU step (docs/gpu.md)
 set -euo pipefail
 
 packages=(
@@ -31,6 +34,12 @@ for arg in "$@"; do
     # clang-14's libFuzzer, ASan and UBSan runtimes are in libclang-rt-14-dev;
     # clang builds OpenMP code against libomp; llvm-14 has llvm-symbolizer
     --with-fuzz) packages+=(clang libclang-rt-14-dev libomp-14-dev llvm-14) ;;
+    --with-cuda)
+      if command -v nvcc >/dev/null || [ -x /usr/local/cuda/bin/nvcc ]; then
+        echo "bootstrap: nvcc present, nvidia-cuda-toolkit not needed"
+      else
+        packages+=(nvidia-cuda-toolkit)
+      fi ;;
     *) echo "bootstrap.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done

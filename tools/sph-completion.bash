@@ -18,7 +18,7 @@ _sph() {
     local scene=twisting_column i
     for ((i = 2; i < COMP_CWORD; ++i)); do
       case "${COMP_WORDS[i - 1]}" in
-      --set | --vary | --out | --resume | --threads | --repeat | --resolution | --json) continue ;;
+      --set | --vary | --out | --resume | --threads | --repeat | --resolution | --json | --device) continue ;;
       esac
       if [[ "${COMP_WORDS[i]}" != -* ]]; then
         scene=${COMP_WORDS[i]}
@@ -29,6 +29,10 @@ _sph() {
     keys=$("$sph" check "$scene" --keys 2>/dev/null | sed 's/$/=/')
     compopt -o nospace 2>/dev/null
     COMPREPLY=($(compgen -W "$keys" -- "$cur"))
+    return
+    ;;
+  --device)
+    COMPREPLY=($(compgen -W "cpu cuda" -- "$cur"))
     return
     ;;
   --out | --resume | --json | --diff)

@@ -64,8 +64,9 @@ enum {
   SPH_OPT_KEYS,
   SPH_OPT_MAX_MEMORY,
   SPH_OPT_RESOLVED,
-  SPH_OPT_CASE, /* bench: --case TEXT */
-  SPH_OPT_MPI   /* bench: --mpi */
+  SPH_OPT_CASE,  /* bench: --case TEXT */
+  SPH_OPT_MPI,   /* bench: --mpi */
+  SPH_OPT_DEVICE /* run, check: --device cpu|cuda (--set device=...) */
 };
 
 /* A command for sph_app_getopt: its usage text, the option ids it allows

@@ -6,6 +6,7 @@
 #include "app/app_impl.h"
 #include "scene/node.h"
 #include "scene/scene.h"
+#include "solver/device.h"
 #include "solver/sim.h"
 
 static double peak_rss_mib(void) {
@@ -49,19 +50,40 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
          peak_rss_mib(), (double)sph_particles_bytes(ps) / 1048576.0);
 }
 
-static const int check_allowed[] = {SPH_OPT_SET, SPH_OPT_KEYS, SPH_OPT_RESOLVED,
-                                    SPH_OPT_MAX_MEMORY, 0};
+/* with a `device` key (or --device): where each part runs, then whether
+ * this build and machine can; exit 2 (the reason printed) when not */
+static int print_device(const sph_scene *s, sph_sim *sim) {
+  char plan[4096];
+  sph_error err, avail;
+  sph_error_clear(&err);
+  sph_error_clear(&avail);
+  sph_status st = sph_device_plan(sim, plan, sizeof plan, &err);
+  printf("device     %s\n%s", s->device == SPH_DEVICE_CUDA ? "cuda" : "cpu",
+         plan);
+  if (st == SPH_OK)
+    st = sph_device_attach(sim, &err);
+  sph_status sa = sph_device_available(s, &avail);
+  if (st == SPH_OK && sa == SPH_OK)
+    return SPH_EXIT_OK;
+  sph_app_print_error(sa != SPH_OK ? &avail : &err);
+  return SPH_EXIT_USAGE;
+}
+
+static const int check_allowed[] = {SPH_OPT_SET,      SPH_OPT_KEYS,
+                                    SPH_OPT_RESOLVED, SPH_OPT_MAX_MEMORY,
+                                    SPH_OPT_DEVICE,   0};
 static const sph_app_command check_command = {
     "check",
     "usage: sph check SCENE [--set key=value]... [--keys | --resolved]\n"
-    "                 [--max-memory SIZE]\n"
+    "                 [--max-memory SIZE] [--device cpu|cuda]\n"
     "  validate SCENE (a file or a shipped scene's name) and print what a\n"
     "  run would simulate: bodies, method, terms, time step, memory;\n"
     "  --keys: every key the scene has, defaults filled in, as --set writes\n"
     "  it (bodies.0.particles.count), one per line; --resolved: the scene\n"
     "  with every default filled in, as a run's scene_used.yaml holds it;\n"
     "  --max-memory: refuse a scene estimated to need more than SIZE (4G,\n"
-    "  512M; default 90 % of the memory available)\n",
+    "  512M; default 90 % of the memory available); --device: where each\n"
+    "  part would run, exit 2 when one cannot run there (docs/gpu.md)\n",
     check_allowed, NULL, NULL};
 
 /* --keys: the resolved tree's key paths in --set's form ([k] -> .k) */
@@ -99,8 +121,11 @@ int sph_cmd_check(int argc, char **argv) {
            sph_node_write(scene->root, stdout, &err) != SPH_OK) {
     sph_app_print_error(&err); /* stdout closed or full */
     rc = SPH_EXIT_IO;
-  } else if (!args.resolved)
+  } else if (!args.resolved) {
     print_plan(scene, sim);
+    if (scene->device_at)
+      rc = print_device(scene, sim);
+  }
   sph_sim_destroy(sim);
   sph_scene_destroy(scene);
   return rc;

@@ -69,17 +69,22 @@ static void print_sink_times(const sph_sink *sinks, int nsinks, double wall) {
 }
 
 static const int run_allowed[] = {
-    SPH_OPT_SET,       SPH_OPT_OUT,   SPH_OPT_THREADS,    SPH_OPT_RESUME_DIR,
-    SPH_OPT_OVERWRITE, SPH_OPT_QUIET, SPH_OPT_MAX_MEMORY, 0};
+    SPH_OPT_SET,        SPH_OPT_OUT,       SPH_OPT_THREADS,
+    SPH_OPT_RESUME_DIR, SPH_OPT_OVERWRITE, SPH_OPT_QUIET,
+    SPH_OPT_MAX_MEMORY, SPH_OPT_DEVICE,    0};
 static const sph_app_command run_command = {
     "run",
     "usage: sph run [SCENE] [--set key=value]... [--out DIR] [--threads N]\n"
     "               [--overwrite] [--quiet] [--resume DIR] [--max-memory "
     "SIZE]\n"
+    "               [--device cpu|cuda]\n"
     "  simulate SCENE (a file, or a shipped scene's name: sph list; default\n"
     "  twisting_column) to its end time; exit 0 stable, 1 unstable, 2 bad\n"
     "  input or usage, 3 I/O failure; a run estimated to need more than\n"
-    "  SIZE (4G, 512M; default 90 % of the memory available) is refused\n",
+    "  SIZE (4G, 512M; default 90 % of the memory available) is refused;\n"
+    "  --device cuda (the scene's device: cuda) steps on the GPU, refused\n"
+    "  (exit 2, nothing written) without CUDA, a GPU, or a GPU path for the\n"
+    "  method and its terms (docs/gpu.md)\n",
     run_allowed, NULL, NULL};
 
 /* SIGINT, SIGTERM, SIGHUP, SIGUSR1 (which mpirun forwards to the ranks

@@ -195,6 +195,19 @@ static int args_option(void *ctx, int id, const char *val) {
     return SPH_EXIT_OK;
   case SPH_OPT_MAX_MEMORY:
     return sph_app_bytes(val, &args->max_memory);
+  case SPH_OPT_DEVICE:
+    /* the scene's `device` key (docs/gpu.md), as --set writes it */
+    if (strcmp(val, "cpu") && strcmp(val, "cuda")) {
+      fprintf(stderr, "sph: --device is cpu or cuda (got '%s')\n", val);
+      return SPH_EXIT_USAGE;
+    }
+    if (args->nsets >= SPH_MAX_SETS) {
+      fprintf(stderr, "sph: more than %d --set options\n", SPH_MAX_SETS);
+      return SPH_EXIT_USAGE;
+    }
+    args->sets[args->nsets++] =
+        strcmp(val, "cpu") ? "device=cuda" : "device=cpu";
+    return SPH_EXIT_OK;
   default:
     return SPH_EXIT_USAGE;
   }

@@ -39,6 +39,7 @@ static const struct option all_options[] = {
     {"resolved", no_argument, NULL, SPH_OPT_RESOLVED},
     {"case", required_argument, NULL, SPH_OPT_CASE},
     {"mpi", no_argument, NULL, SPH_OPT_MPI},
+    {"device", required_argument, NULL, SPH_OPT_DEVICE},
 };
 #define NALL (sizeof all_options / sizeof *all_options)
 

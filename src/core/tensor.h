@@ -11,16 +11,18 @@
 #include <math.h>
 #include <string.h>
 
-static inline double sph_vec3_dot(const double a[3], const double b[3]) {
+#include "core/hd.h"
+
+SPH_HD static inline double sph_vec3_dot(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static inline double sph_vec3_norm(const double a[3]) {
+SPH_HD static inline double sph_vec3_norm(const double a[3]) {
   return sqrt(sph_vec3_dot(a, a));
 }
 
-static inline void sph_vec3_cross(const double a[3], const double b[3],
-                                  double out[3]) {
+SPH_HD static inline void sph_vec3_cross(const double a[3], const double b[3],
+                                         double out[3]) {
   double c0 = a[1] * b[2] - a[2] * b[1];
   double c1 = a[2] * b[0] - a[0] * b[2];
   double c2 = a[0] * b[1] - a[1] * b[0];
@@ -29,33 +31,36 @@ static inline void sph_vec3_cross(const double a[3], const double b[3],
   out[2] = c2;
 }
 
-static inline void sph_mat3_zero(double A[9]) { memset(A, 0, 9 * sizeof *A); }
+SPH_HD static inline void sph_mat3_zero(double A[9]) {
+  memset(A, 0, 9 * sizeof *A);
+}
 
-static inline void sph_mat3_identity(double A[9]) {
+SPH_HD static inline void sph_mat3_identity(double A[9]) {
   sph_mat3_zero(A);
   A[0] = A[4] = A[8] = 1.0;
 }
 
-static inline double sph_mat3_trace(const double A[9]) {
+SPH_HD static inline double sph_mat3_trace(const double A[9]) {
   return A[0] + A[4] + A[8];
 }
 
 /* A : B = A_ij B_ij */
-static inline double sph_mat3_ddot(const double A[9], const double B[9]) {
+SPH_HD static inline double sph_mat3_ddot(const double A[9],
+                                          const double B[9]) {
   double s = 0.0;
   for (int k = 0; k < 9; ++k)
     s += A[k] * B[k];
   return s;
 }
 
-static inline void sph_mat3_transpose(const double A[9], double T[9]) {
+SPH_HD static inline void sph_mat3_transpose(const double A[9], double T[9]) {
   double t[9] = {A[0], A[3], A[6], A[1], A[4], A[7], A[2], A[5], A[8]};
   memcpy(T, t, sizeof t);
 }
 
 /* C = A B (C may alias A or B) */
-static inline void sph_mat3_mul(const double A[9], const double B[9],
-                                double C[9]) {
+SPH_HD static inline void sph_mat3_mul(const double A[9], const double B[9],
+                                       double C[9]) {
   double t[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -65,8 +70,8 @@ static inline void sph_mat3_mul(const double A[9], const double B[9],
 }
 
 /* y = A x (y may alias x) */
-static inline void sph_mat3_vec(const double A[9], const double x[3],
-                                double y[3]) {
+SPH_HD static inline void sph_mat3_vec(const double A[9], const double x[3],
+                                       double y[3]) {
   double t0 = A[0] * x[0] + A[1] * x[1] + A[2] * x[2];
   double t1 = A[3] * x[0] + A[4] * x[1] + A[5] * x[2];
   double t2 = A[6] * x[0] + A[7] * x[1] + A[8] * x[2];
@@ -76,14 +81,14 @@ static inline void sph_mat3_vec(const double A[9], const double x[3],
 }
 
 /* A += a (x) b */
-static inline void sph_mat3_add_outer(double A[9], const double a[3],
-                                      const double b[3]) {
+SPH_HD static inline void sph_mat3_add_outer(double A[9], const double a[3],
+                                             const double b[3]) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       A[3 * i + j] += a[i] * b[j];
 }
 
-static inline double sph_mat3_det(const double A[9]) {
+SPH_HD static inline double sph_mat3_det(const double A[9]) {
   return A[0] * (A[4] * A[8] - A[5] * A[7]) -
          A[1] * (A[3] * A[8] - A[5] * A[6]) +
          A[2] * (A[3] * A[7] - A[4] * A[6]);
@@ -91,7 +96,7 @@ static inline double sph_mat3_det(const double A[9]) {
 
 /* Cofactor H = det(A) A^-T, computed without dividing (valid for singular A).
  * Equals 1/2 A x A (seed 000). */
-static inline void sph_mat3_cofactor(const double A[9], double H[9]) {
+SPH_HD static inline void sph_mat3_cofactor(const double A[9], double H[9]) {
   double t[9];
   t[0] = A[4] * A[8] - A[5] * A[7];
   t[1] = A[5] * A[6] - A[3] * A[8];
@@ -106,7 +111,8 @@ static inline void sph_mat3_cofactor(const double A[9], double H[9]) {
 }
 
 /* Ainv = A^-1; returns det(A). Ainv is untouched when det(A) == 0. */
-static inline double sph_mat3_inverse(const double A[9], double Ainv[9]) {
+SPH_HD static inline double sph_mat3_inverse(const double A[9],
+                                             double Ainv[9]) {
   double H[9];
   sph_mat3_cofactor(A, H);
   double det = A[0] * H[0] + A[1] * H[1] + A[2] * H[2];
@@ -121,8 +127,8 @@ static inline double sph_mat3_inverse(const double A[9], double Ainv[9]) {
 }
 
 /* Tensor cross product of seed 000: C_iI = E_ijk E_IJK A_jJ B_kK. */
-static inline void sph_mat3_tensor_cross(const double A[9], const double B[9],
-                                         double C[9]) {
+SPH_HD static inline void
+sph_mat3_tensor_cross(const double A[9], const double B[9], double C[9]) {
   static const int nxt[3] = {1, 2, 0};
   static const int prv[3] = {2, 0, 1};
   double t[9];
@@ -139,7 +145,7 @@ static inline void sph_mat3_tensor_cross(const double A[9], const double B[9],
 }
 
 /* 1-norm (largest column sum of absolute values) */
-static inline double sph_mat3_norm1(const double A[9]) {
+SPH_HD static inline double sph_mat3_norm1(const double A[9]) {
   double best = 0.0;
   for (int j = 0; j < 3; ++j) {
     double s = fabs(A[j]) + fabs(A[3 + j]) + fabs(A[6 + j]);
@@ -151,8 +157,8 @@ static inline double sph_mat3_norm1(const double A[9]) {
 
 /* Eigen-decomposition of a symmetric A = Q diag(w) Q^T by cyclic Jacobi
  * rotations (columns of Q are the eigenvectors, row-major storage). */
-static inline void sph_mat3_sym_eigen(const double A[9], double w[3],
-                                      double Q[9]) {
+SPH_HD static inline void sph_mat3_sym_eigen(const double A[9], double w[3],
+                                             double Q[9]) {
   double a[9];
   memcpy(a, A, sizeof a);
   sph_mat3_identity(Q);
@@ -193,8 +199,8 @@ static inline void sph_mat3_sym_eigen(const double A[9], double w[3],
 }
 
 /* Smallest and largest eigenvalue of a symmetric A (trigonometric method). */
-static inline void sph_mat3_sym_extremes(const double A[9], double *lo,
-                                         double *hi) {
+SPH_HD static inline void sph_mat3_sym_extremes(const double A[9], double *lo,
+                                                double *hi) {
   double p1 = A[1] * A[1] + A[2] * A[2] + A[5] * A[5];
   double q = (A[0] + A[4] + A[8]) / 3.0;
   double p2 = (A[0] - q) * (A[0] - q) + (A[4] - q) * (A[4] - q) +

@@ -11,14 +11,11 @@
 
 #include "core/tensor.h"
 #include "materials/material_impl.h"
+#include "materials/neo_hookean_law.h"
 
 static void neo_hookean_stress(const sph_material *m, const double F[9],
                                const double H[9], double J, double P[9]) {
-  double j23 = pow(J, -2.0 / 3.0);
-  double ff = sph_mat3_ddot(F, F);
-  double p = m->kappa * (J - 1.0);
-  for (int k = 0; k < 9; ++k)
-    P[k] = m->mu * j23 * (F[k] - ff / (3.0 * J) * H[k]) + p * H[k];
+  sph_neo_hookean_law(m->mu, m->kappa, F, H, J, P);
 }
 
 static double neo_hookean_energy(const sph_material *m, const double F[9],

@@ -193,10 +193,17 @@ typedef struct sph_stability_options {
   double zigzag_max;  /* von Mises roughness */
 } sph_stability_options;
 
+/* Where a run's time step runs (docs/gpu.md). */
+typedef enum sph_device { SPH_DEVICE_CPU, SPH_DEVICE_CUDA } sph_device;
+
 typedef struct sph_scene {
   char name[SPH_NAME_MAX];
   char path[512];
   int dimension;
+  /* where the time step runs (`device`, absent: the CPU); device_at the
+   * key, for errors, or NULL */
+  sph_device device;
+  sph_node *device_at;
   sph_node *root;      /* the resolved tree (defaults filled) */
   sph_node *method;    /* the method block, validated by the method */
   sph_node *reference; /* optional `reference:` block (analytic solution or

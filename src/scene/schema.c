@@ -202,7 +202,7 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
   static const char *const keys[] = {
       "name",      "dimension",  "method",     "kernel", "materials",
       "bodies",    "boundaries", "body_force", "time",   "output",
-      "reference", "stability",  "contact",    NULL};
+      "reference", "stability",  "contact",    "device", NULL};
   SPH_TRY(sph_node_check_keys(root, keys, err));
   const char *name;
   SPH_TRY(sph_node_get_string(root, "name", 1, NULL, &name, err));
@@ -222,6 +222,13 @@ static sph_status parse_scene(sph_scene *s, sph_node *root, sph_error *err) {
     return sph_node_error(sph_node_child(root, "dimension"), err, SPH_ERR_RANGE,
                           "dimension is 2 or 3, got %ld", dim);
   s->dimension = (int)dim;
+  /* read only when given: a scene without it resolves as before */
+  if ((s->device_at = sph_node_child(root, "device"))) {
+    static const char *const devices[] = {"cpu", "cuda", NULL};
+    int d;
+    SPH_TRY(sph_node_get_choice(root, "device", devices, "cpu", &d, err));
+    s->device = d == 1 ? SPH_DEVICE_CUDA : SPH_DEVICE_CPU;
+  }
   SPH_TRY(sph_node_get_map(root, "method", 1, &s->method, err));
   const char *method;
   SPH_TRY(sph_node_get_string(s->method, "name", 1, NULL, &method, err));

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "io/checkpoint.h"
+#include "solver/device.h"
 #include "solver/run_impl.h"
 
 static double run_eps(const sph_run *run) { return 1e-12 * run->scene->t_end; }
@@ -63,7 +64,13 @@ sph_status sph_run_open(sph_run **out, const sph_scene *scene,
   run->root = sph_domain_world_rank() == 0;
   if (run->opt.threads > 0)
     omp_set_num_threads(run->opt.threads);
-  sph_status st = sph_sim_create(&run->sim, scene, err);
+  /* device: cuda refused before the particles are built, and before
+   * anything is written */
+  sph_status st = sph_device_available(scene, err);
+  if (st == SPH_OK)
+    st = sph_sim_create(&run->sim, scene, err);
+  if (st == SPH_OK)
+    st = sph_device_attach(run->sim, err);
   if (st == SPH_OK && !run->opt.no_files) /* no frames without files */
     st = sph_png_check(run->sim, err);
   if (st == SPH_OK)

@@ -5,6 +5,7 @@
 
 #include "core/check.h"
 #include "core/tensor.h"
+#include "gpu/gpu.h"
 #include "parallel/domain.h"
 #include "scene/geometry.h"
 #include "scene/node.h"
@@ -383,6 +384,7 @@ void sph_sim_destroy(sph_sim *sim) {
   for (int i = 0; i < sim->nterms; ++i)
     if (sim->terms[i].ops->destroy)
       sim->terms[i].ops->destroy(&sim->terms[i]);
+  sph_device_run_destroy(sim->device);
   if (sim->method && sim->method->destroy)
     sim->method->destroy(sim);
   sph_particles_destroy(sim->ps);
@@ -424,7 +426,8 @@ sph_status sph_sim_step(sph_sim *sim, double dt_cap, sph_error *err) {
   SPH_CHECK(dt > 0.0 && isfinite(dt), err,
             "time step %g at t = %g (stable %g, cap %g)", dt, sim->t,
             sim->dt_stable_peak, dt_cap);
-  sph_status st = sim->method->step(sim, dt, err);
+  sph_status st = sim->device ? sph_device_run_step(sim->device, dt, err)
+                              : sim->method->step(sim, dt, err);
   if (st == SPH_ERR_SINGULAR)
     blame_singular(sim, err);
   /* a rank's failed check reaches every rank through the agreement */

@@ -44,6 +44,7 @@ typedef struct sph_term_ops {
   const char *name;      /* as printed and in summary.json */
   const char *reference; /* seed and equations */
   int distributed;       /* runs over MPI ranks on owned particles */
+  int gpu; /* 1: runs on the device with the method's step (docs/gpu.md) */
   /* adds its contribution to the stage rates (may be NULL) */
   sph_status (*rates)(sph_term *term, sph_sim *sim, sph_stage *stage,
                       sph_error *err);
@@ -84,6 +85,8 @@ typedef struct sph_method_ops {
    * reference neighbourhoods, SPH_DISTRIBUTED_DYNAMIC with the ghosts found
    * again, migration and re-balancing at its rebuilds (updated Lagrangian) */
   int distributed;
+  /* 1: `device: cuda` runs its step on the GPU (docs/gpu.md); 0: refused */
+  int gpu;
   unsigned long fields; /* the output fields it fills: bit 1ul << f */
   /* validates the method block, requires fields, creates its terms */
   sph_status (*setup)(sph_sim *sim, sph_node *options, sph_error *err);
@@ -115,6 +118,8 @@ typedef struct sph_timer {
 
 struct sph_sim {
   const sph_scene *scene;
+  /* the step on the device (`device: cuda`, gpu/device_run.c), or NULL */
+  struct sph_device_run *device;
   const sph_method_ops *method;
   void *method_data;
   sph_particles *ps;

@@ -8,64 +8,30 @@
 #include <string.h>
 
 #include "core/tensor.h"
+#include "terms/momentum_projection.h"
 #include "terms/terms_impl.h"
 
-/* The sums run over a fixed number of blocks of consecutive particles,
- * added in block order: the same bits on any thread count, and no work
- * array (the partial sums live on the stack). Small sets stay on one
- * thread. */
-enum { PROJ_BLOCKS = 64, PROJ_PARALLEL_MIN = 32768 };
+/* The sums run over SPH_PROJ_BLOCKS blocks of consecutive particles, added
+ * in block order (momentum_projection.h): the same bits on any thread count,
+ * and no work array (the partial sums live on the stack). Small sets stay
+ * on one thread. */
+enum { PROJ_PARALLEL_MIN = 32768 };
 
-/* the volume, V X and V w of body b (7 sums), or with xc given the inertia
- * about xc and the moment of w (12 sums), over particles [lo, hi) */
-static void body_block_sums(size_t lo, size_t hi, const double *V,
-                            const double *X, const int32_t *body, int b,
-                            const double *w, const double *xc, double *s) {
-  if (!xc) {
-    for (size_t a = lo; a < hi; ++a) {
-      if (body[a] != b)
-        continue;
-      s[0] += V[a];
-      for (int c = 0; c < 3; ++c) {
-        s[1 + c] += V[a] * X[3 * a + c];
-        s[4 + c] += V[a] * w[3 * a + c];
-      }
-    }
-    return;
-  }
-  double *I = s, *m = s + 9;
-  for (size_t a = lo; a < hi; ++a) {
-    if (body[a] != b)
-      continue;
-    double y[3] = {X[3 * a] - xc[0], X[3 * a + 1] - xc[1],
-                   X[3 * a + 2] - xc[2]};
-    double yy = sph_vec3_dot(y, y), t[3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        I[3 * i + j] += V[a] * ((i == j) * yy - y[i] * y[j]);
-    sph_vec3_cross(y, w + 3 * a, t);
-    for (int c = 0; c < 3; ++c)
-      m[c] += V[a] * t[c];
-  }
-}
-
-/* the block sums of body_block_sums (count 7 or 12) added in block order */
+/* the block sums of sph_proj_block_sums (count 7 or 12) added in block
+ * order */
 static void body_sums(size_t n, const double *V, const double *X,
                       const int32_t *body, int b, const double *w,
                       const double *xc, int count, double *out) {
-  double part[PROJ_BLOCKS][12];
+  double part[SPH_PROJ_BLOCKS * 12];
   memset(part, 0, sizeof part);
-  size_t len = (n + PROJ_BLOCKS - 1) / PROJ_BLOCKS;
 #pragma omp parallel for schedule(static) if (n >= PROJ_PARALLEL_MIN)
-  for (int k = 0; k < PROJ_BLOCKS; ++k) {
-    size_t lo = (size_t)k * len, hi = lo + len < n ? lo + len : n;
+  for (int k = 0; k < SPH_PROJ_BLOCKS; ++k) {
+    size_t lo, hi;
+    sph_proj_block_range(n, k, &lo, &hi);
     if (lo < hi)
-      body_block_sums(lo, hi, V, X, body, b, w, xc, part[k]);
+      sph_proj_block_sums(lo, hi, V, X, body, b, w, xc, part + 12 * k);
   }
-  memset(out, 0, (size_t)count * sizeof *out);
-  for (int k = 0; k < PROJ_BLOCKS; ++k)
-    for (int c = 0; c < count; ++c)
-      out[c] += part[k][c];
+  sph_proj_add_blocks(part, count, out);
 }
 
 void sph_momentum_projection(sph_domain *d, size_t n, const double *V,
@@ -74,40 +40,23 @@ void sph_momentum_projection(sph_domain *d, size_t n, const double *V,
   for (int b = 0; b < nbodies; ++b) {
     /* centroid, total force and volume of the body */
     double s[7]; /* volume, V X, V w */
-    double *xc = s + 1, *sum = s + 4;
     body_sums(n, V, X, body, b, w, NULL, 7, s);
     sph_domain_sum(d, s, 7);
-    double vol = s[0];
-    if (!(vol > 0.0))
+    if (!sph_proj_centroid(s))
       continue;
-    for (int c = 0; c < 3; ++c)
-      xc[c] /= vol;
+    const double *xc = s + 1;
     /* inertia about the centroid and moment of w */
-    double Im[12], *I = Im, *m = Im + 9;
+    double Im[12];
     body_sums(n, V, X, body, b, w, xc, 12, Im);
     sph_domain_sum(d, Im, 12);
     /* planar bodies have no inertia about in-plane axes: keep the z part */
-    double Iinv[9], lambda[3] = {0, 0, 0};
-    if (sph_mat3_inverse(I, Iinv) != 0.0) {
-      sph_mat3_vec(Iinv, m, lambda);
-    } else if (I[8] > 0.0) {
-      lambda[2] = m[2] / I[8];
-    }
-    for (int c = 0; c < 3; ++c)
-      lambda[c] = -lambda[c];
-    double mu[3] = {-sum[0] / vol, -sum[1] / vol, -sum[2] / vol};
+    double lambda[3], mu[3];
+    sph_proj_coefficients(s, Im, lambda, mu);
     long nl = (long)n;
 #pragma omp parallel for schedule(static) if (n >= PROJ_PARALLEL_MIN)
-    for (long a = 0; a < nl; ++a) {
-      if (body[a] != b)
-        continue;
-      double y[3] = {X[3 * a] - xc[0], X[3 * a + 1] - xc[1],
-                     X[3 * a + 2] - xc[2]};
-      double t[3];
-      sph_vec3_cross(lambda, y, t);
-      for (int c = 0; c < 3; ++c)
-        w[3 * a + c] += t[c] + mu[c];
-    }
+    for (long a = 0; a < nl; ++a)
+      if (body[a] == b)
+        sph_proj_apply_one((size_t)a, X, xc, lambda, mu, w);
   }
 }
 
@@ -124,6 +73,7 @@ const sph_term_ops angular_momentum_projection_term_ops = {
     .name = "angular_momentum_projection",
     .reference = "seed 000 sec. 6 eq. 45-48",
     .distributed = 1,
+    .gpu = 1,
     .rates = projection_rates,
 };
 

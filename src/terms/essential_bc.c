@@ -117,6 +117,7 @@ static void bc_destroy(sph_term *term) {
 
 const sph_term_ops essential_bc_term_ops = {
     .name = "essential_bc",
+    .gpu = 1, /* clamps (gpu/tl_jst_gpu_one.h) */
     .reference = "seed 000 Algorithm 1 step 8",
     .distributed = 1,
     .rates = bc_rates,

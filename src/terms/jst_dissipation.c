@@ -142,6 +142,7 @@ static void jst_destroy(sph_term *term) {
 const sph_term_ops jst_p_term_ops = {
     .name = "jst_dissipation_p",
     .reference = "seed 000 eq. 35-38, projection eq. 49",
+    .gpu = 1,
     .distributed = 1,
     .rates = jst_rates,
     .destroy = jst_destroy,

@@ -9,7 +9,10 @@
 
 #include <string.h>
 
+#include "core/hd.h"
 #include "core/tensor.h"
+
+#ifndef __CUDACC__
 
 /* Two doubles in one register (GCC and Clang vector extension), so that a
  * sweep keeps its twelve sums in registers rather than on the stack. */
@@ -86,9 +89,11 @@ static inline void ref_sums_store(const ref_sums *s, double G[9], double f[3]) {
   f[2] = s->f2;
 }
 
+#endif /* !__CUDACC__: the register sums are the CPU sweep's */
+
 /* r_ab = X_a - X_b */
-static inline void ref_iact_pair_vector(const double *X, size_t a, size_t b,
-                                        double r[3]) {
+SPH_HD static inline void ref_iact_pair_vector(const double *X, size_t a,
+                                               size_t b, double r[3]) {
   for (int c = 0; c < 3; ++c)
     r[c] = X[3 * a + c] - X[3 * b + c];
 }
@@ -96,8 +101,10 @@ static inline void ref_iact_pair_vector(const double *X, size_t a, size_t b,
 /* Gradient of a vector field before the correction (seed 000 eq. 21; with
  * f = p eq. 33a, with f = x eq. 34): G += w_ab (f_b - f_a) (x) r_ab; the
  * corrected gradient is G L_a^T (ref_iact_gradient_correct). */
-static inline void ref_iact_gradient(double G[9], double w, const double fa[3],
-                                     const double fb[3], const double r[3]) {
+SPH_HD static inline void ref_iact_gradient(double G[9], double w,
+                                            const double fa[3],
+                                            const double fb[3],
+                                            const double r[3]) {
   for (int i = 0; i < 3; ++i) {
     double d = w * (fb[i] - fa[i]);
     G[3 * i] += d * r[0];
@@ -106,8 +113,27 @@ static inline void ref_iact_gradient(double G[9], double w, const double fa[3],
   }
 }
 
+/* ref_iact_force2 on plain sums (the device step, src/gpu): the same
+ * products and sums per component, f += w_ab Q_b r_ab with Q_b stored
+ * transposed */
+SPH_HD static inline void
+ref_iact_force(double f[3], double w, const double Qtb[9], const double r[3]) {
+  double r0 = w * r[0], r1 = w * r[1], wr2 = w * r[2];
+  for (int c = 0; c < 3; ++c)
+    f[c] += r0 * Qtb[c] + r1 * Qtb[3 + c] + wr2 * Qtb[6 + c];
+}
+
+/* ref_iact_laplacian2 on plain sums: l += lap_ab (f_b - f_a) */
+SPH_HD static inline void ref_iact_laplacian(double l[3], double lap,
+                                             const double fa[3],
+                                             const double fb[3]) {
+  for (int c = 0; c < 3; ++c)
+    l[c] += lap * (fb[c] - fa[c]);
+}
+
 /* G <- G L^T */
-static inline void ref_iact_gradient_correct(double G[9], const double L[9]) {
+SPH_HD static inline void ref_iact_gradient_correct(double G[9],
+                                                    const double L[9]) {
   double out[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -119,7 +145,7 @@ static inline void ref_iact_gradient_correct(double G[9], const double L[9]) {
 
 /* Plane strain in 2D: the gradient of x has no z row or column but
  * F_zz = 1 (the points all lie in one plane, so the sums leave it 0). */
-static inline void ref_iact_plane_strain(double F[9], int dim) {
+SPH_HD static inline void ref_iact_plane_strain(double F[9], int dim) {
   if (dim == 2) {
     F[2] = F[5] = F[6] = F[7] = 0.0;
     F[8] = 1.0;
@@ -132,8 +158,8 @@ static inline void ref_iact_plane_strain(double F[9], int dim) {
  *      = Q_a s_a + sum_b w_ab Q_b r_ab with Q = P L and s_a = sum_b w_ab r_ab:
  * ref_iact_force2 adds the pair's share w_ab Q_b r_ab, this the Q_a s_a part
  * (Q stored transposed). */
-static inline void ref_iact_force_self(const double Qta[9], const double sa[3],
-                                       double out[3]) {
+SPH_HD static inline void
+ref_iact_force_self(const double Qta[9], const double sa[3], double out[3]) {
   for (int i = 0; i < 3; ++i)
     out[i] = Qta[i] * sa[0] + Qta[3 + i] * sa[1] + Qta[6 + i] * sa[2];
 }

@@ -568,6 +568,7 @@ const sph_method_ops tl_jst_method_ops = {
                  "eq. 11",
     .conserves_angular_momentum = 1,
     .distributed = 1,
+    .gpu = 1, /* pF with the conservative force (gpu/tl_jst_twin.c) */
     .fields = SPH_REF_OUTPUT_FIELDS,
     .setup = tl_jst_setup,
     .stable_dt = tl_jst_stable_dt,
