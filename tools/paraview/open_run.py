@@ -6,7 +6,8 @@ one from azimuth 30, elevation 20, fitted to the bodies, at the last time
 step.
 
   pvbatch tools/paraview/open_run.py DIR [--field F] [--screenshot OUT.png]
-          [--size WxH]            (headless: under xvfb-run -a without X)
+          [--size WxH]     (headless, without X: under xvfb-run -a -s
+                            '-screen 0 1280x1024x24 -noreset')
   paraview --script=tools/paraview/open_run.py        (with SPH_RUN=DIR)
 """
 import glob
@@ -14,7 +15,6 @@ import math
 import os
 import sys
 
-import paraview
 from paraview import servermanager
 from paraview import simple as pv
 from vtkmodules.vtkCommonCore import vtkIdList
@@ -29,7 +29,7 @@ LEFT = 0.1  # the bodies' centre that far left of the middle, clear of the bar
 def parse(argv):
     opt = {"run": os.environ.get("SPH_RUN", ""), "field": "pressure",
            "shot": None, "size": [1280, 720],
-           "gui": paraview.fromGUI}
+           "gui": pv.GetActiveView() is not None}  # the GUI made a view
     args = list(argv)
     while args:
         a = args.pop(0)
@@ -60,21 +60,23 @@ def polydata(reader, time):
     return out
 
 
-def spacing(points):  # a vtkPolyData
-    """The median distance from a particle to its nearest neighbour."""
-    n = points.GetNumberOfPoints()
+def spacing(poly):
+    """The median distance from a particle of POLY (a sample of 2000 at
+    most) to its nearest neighbour."""
+    n = poly.GetNumberOfPoints()
     if n < 2:
         return 0.0
     loc = vtkStaticPointLocator()
-    loc.SetDataSet(points)
+    loc.SetDataSet(poly)
     loc.BuildLocator()
     ids = vtkIdList()
     step = max(1, n // 2000)
     d = []
     for i in range(0, n, step):
-        p = points.GetPoint(i)
+        p = poly.GetPoint(i)
         loc.FindClosestNPoints(2, p, ids)
-        q = points.GetPoint(ids.GetId(1) if ids.GetId(0) == i else ids.GetId(0))
+        j = ids.GetId(1) if ids.GetId(0) == i else ids.GetId(0)
+        q = poly.GetPoint(j)
         d.append(math.dist(p, q))
     d.sort()
     return d[len(d) // 2]
@@ -109,7 +111,8 @@ def fit_camera(view, bounds, is2d, radius):
     back = [p - c for p, c in zip(pos, centre)]
     norm = math.sqrt(sum(b * b for b in back))
     back = [b / norm for b in back]
-    right = [up[1] * back[2] - up[2] * back[1], up[2] * back[0] - up[0] * back[2],
+    right = [up[1] * back[2] - up[2] * back[1],
+             up[2] * back[0] - up[0] * back[2],
              up[0] * back[1] - up[1] * back[0]]
     tv = math.tan(math.radians(camera.GetViewAngle()) / 2)
     th = tv * aspect
@@ -144,6 +147,7 @@ def main(argv):
     view = pv.GetActiveViewOrCreate("RenderView")
     if opt["shot"] or not opt["gui"]:  # the GUI's view keeps its size
         view.ViewSize = opt["size"]
+    pv.GetTimeKeeper().Time = times[-1]  # the GUI's views follow it
     view.ViewTime = times[-1]
     if hasattr(view, "UseColorPaletteForBackground"):
         view.UseColorPaletteForBackground = 0  # else the palette's wins
