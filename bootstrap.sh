@@ -21,7 +21,10 @@ packages=(
   libosmesa6-dev    # off-screen OpenGL renderer
   libfreetype-dev fonts-dejavu-core  # text on frames
   libfontconfig-dev # the frames' font found through fontconfig
-  python3-vtk9      # VTK's own reader validates the files we write (tests)
+  # ParaView as a tested client (io_paraview: pvbatch under xvfb-run); its
+  # Python package's vtkmodules are VTK's own readers, which validate the
+  # files we write (tests); it conflicts with python3-vtk9, which it replaces
+  paraview python3-paraview xvfb xauth  # xvfb-run needs xauth (a Recommends)
   python3-numpy     # the sph Python package's field arrays (python/sph)
   python3-pytest    # the Python package's tests (tests/python)
   clang-format      # formatting is a test

@@ -13,7 +13,8 @@
  * gives their offsets. Over MPI ranks (sph_domain) each rank writes its
  * owned particles as a piece <scene>_NNNN_pR.vtp and rank 0, once every
  * piece is in place, the <scene>_NNNN.pvtp that lists them (VTK's
- * parallel PolyData), which the .pvd names. */
+ * parallel PolyData) with the time as TimeValue field data, like every
+ * .vtp, which the .pvd names. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -234,9 +235,16 @@ static sph_status write_pvtp(const vtk_sink *v, const sph_frame *fr,
   SPH_TRY(sph_atomic_open(&af, path, err));
   fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"PPolyData\" "
         "version=\"1.0\" byte_order=\"LittleEndian\" "
-        "header_type=\"UInt64\">\n  <PPolyData GhostLevel=\"0\">\n"
-        "    <PPointData>\n",
+        "header_type=\"UInt64\">\n  <PPolyData GhostLevel=\"0\">\n",
         af.f);
+  /* the time as in the pieces: VTK's parallel reader gives it to ParaView
+   * when the .pvtp series is opened without the .pvd */
+  fprintf(af.f,
+          "    <FieldData>\n"
+          "      <DataArray type=\"Float64\" Name=\"TimeValue\" "
+          "NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n"
+          "    </FieldData>\n    <PPointData>\n",
+          fr->time);
   for (int i = 0; i < na; ++i)
     fprintf(af.f,
             "      <PDataArray type=\"%s\" Name=\"%s\" "

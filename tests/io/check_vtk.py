@@ -1,14 +1,15 @@
 #!/usr/bin/python3
-"""Reads what `sph run` wrote with VTK's own XML reader (python3-vtk9) and
-checks it: the .pvd is a Collection with increasing times and every file
-present; every .vtp reads without a VTK error or warning (each in its own
-process: a malformed header can abort the reader); point counts, array
-names and component counts; binary and ASCII runs hold identical values;
-points equal initial_position + displacement; each file's TimeValue field
-data equals its .pvd time; the probe particle's values
-equal probes.csv. Usage: check_vtk.py BINARY_DIR ASCII_DIR SCENE_NAME
-or check_vtk.py --series DIR SCENE_NAME: the .pvd and every file it lists
-read cleanly with the same point count (e.g. after a killed run)."""
+"""Reads what `sph run` wrote with VTK's own XML reader (the vtkmodules of
+Debian's python3-paraview, ParaView's own VTK) and checks it: the .pvd is
+a Collection with increasing times and every file present; every .vtp
+reads without a VTK error or warning (each in its own process: a
+malformed header can abort the reader); point counts, array names and
+component counts; binary and ASCII runs hold identical values; points
+equal initial_position + displacement; each file's TimeValue field data
+equals its .pvd time; the probe particle's values equal probes.csv.
+Usage: check_vtk.py BINARY_DIR ASCII_DIR SCENE_NAME or check_vtk.py
+--series DIR SCENE_NAME: the .pvd and every file it lists read cleanly
+with the same point count (e.g. after a killed run)."""
 import csv
 import os
 import subprocess
@@ -55,7 +56,7 @@ def read_one(path):
         sys.exit("VTK reported %s reading %s" % (problems, path))
     poly = reader.GetOutput()
 
-    def values(a):  # no numpy in Debian's python3-vtk9 dependencies
+    def values(a):  # plain lists: repr() to the parent process
         nc = a.GetNumberOfComponents()
         return [list(a.GetTuple(i)) if nc > 1 else a.GetTuple(i)[0]
                 for i in range(a.GetNumberOfTuples())]

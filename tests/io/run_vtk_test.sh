@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs a small twisting column twice (binary and ASCII VTK) and checks both
 # with VTK's own reader (check_vtk.py, Debian's /usr/bin/python3 with
-# python3-vtk9). 3 x 7 x 3 particles: too coarse for the zig-zag indicator
-# to judge.
+# python3-paraview's vtkmodules). 3 x 7 x 3 particles: too coarse for the
+# zig-zag indicator to judge.
 set -u
 sph=$1
 src=$2

@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Compares a run over MPI ranks with the serial run of the same scene,
-reading the files with VTK's own readers (python3-vtk9): the .pvd names a
-.pvtp per output time at the serial times; each .pvtp (VTK's parallel
-PolyData reader) lists RANKS pieces that read without a VTK error or warning
+reading the files with VTK's own readers (python3-paraview's vtkmodules):
+the .pvd names a .pvtp per output time at the serial times; each .pvtp
+(VTK's parallel PolyData reader) carries that time (TimeValue, the time
+the reader reports when the .pvtp series is opened without the .pvd) and
+lists RANKS pieces that read without a VTK error or warning
 and together hold the serial particle count and arrays; every value equals
 the serial one (matched by particle_id) within REL_TOL of the array's
 largest magnitude; the PNG frames (rank 0, from the gathered particles)
@@ -37,7 +39,7 @@ def read(path):
     if problems:
         fail("VTK reported %s reading %s" % (problems, path))
 
-    def values(a):  # no numpy in Debian's python3-vtk9 dependencies
+    def values(a):  # plain lists, as check_vtk.py
         nc = a.GetNumberOfComponents()
         return [a.GetTuple(i) for i in range(a.GetNumberOfTuples())], nc
 
@@ -49,6 +51,18 @@ def read(path):
         fail("%s has no particle_id" % path)
     ids = [int(t[0]) for t in arrays["particle_id"][0]]
     return poly.GetNumberOfPoints(), ids, arrays
+
+
+def pvtp_time(path):
+    """the times VTK's parallel reader reports for a .pvtp on its own"""
+    from vtkmodules.vtkCommonExecutionModel import \
+        vtkStreamingDemandDrivenPipeline
+    from vtkmodules.vtkIOXML import vtkXMLPPolyDataReader
+    reader = vtkXMLPPolyDataReader()
+    reader.SetFileName(path)
+    reader.UpdateInformation()
+    return reader.GetOutputInformation(0).Get(
+        vtkStreamingDemandDrivenPipeline.TIME_STEPS())
 
 
 def pvd(path):
@@ -85,6 +99,9 @@ def main():
         for p in pieces:
             if not os.path.exists(os.path.join(par, p)):
                 fail("%s names the missing %s" % (pf, p))
+        if pvtp_time(os.path.join(par, pf)) != (t,):
+            fail("%s: VTK reads the time %s, the .pvd says %r"
+                 % (pf, pvtp_time(os.path.join(par, pf)), t))
         ns, sids, sa = read(os.path.join(serial, sf))
         np_, pids, pa = read(os.path.join(par, pf))
         if ns != np_ or sorted(sids) != sorted(pids):
