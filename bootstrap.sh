@@ -18,6 +18,7 @@ packages=(
   libosmesa6-dev    # off-screen OpenGL renderer
   libfreetype-dev fonts-dejavu-core  # text on frames
   libfontconfig-dev # the frames' font found through fontconfig
+  libassimp-dev     # bodies from mesh files: STL, OBJ, PLY... (optional: without it mesh scenes are refused)
   python3-vtk9      # VTK's own reader validates the files we write (tests)
   python3-numpy     # the sph Python package's field arrays (python/sph)
   python3-pytest    # the Python package's tests (tests/python)

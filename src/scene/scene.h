@@ -26,8 +26,12 @@ typedef enum sph_shape_kind {
                          along axis with length */
   SPH_SHAPE_DISC,     /* 2D: center, radius */
   SPH_SHAPE_SPHERE,   /* 3D: center, radius */
-  SPH_SHAPE_SHELL     /* 3D spherical shell: center, inner/outer radius */
+  SPH_SHAPE_SHELL,    /* 3D spherical shell: center, inner/outer radius */
+  SPH_SHAPE_MESH      /* 3D: a closed triangle surface read from a file
+                         (scene/mesh.h); min, max its bounding box */
 } sph_shape_kind;
+
+struct sph_mesh; /* see mesh.h */
 
 typedef struct sph_shape {
   sph_shape_kind kind;
@@ -35,6 +39,8 @@ typedef struct sph_shape {
   double center[3];
   double axis[3]; /* unit vector (cylinder, tube) */
   double radius, inner_radius, outer_radius, length;
+  struct sph_mesh *mesh; /* owned by the scene */
+  char file[256];        /* the mesh file as the scene names it */
 } sph_shape;
 
 typedef enum sph_lattice {

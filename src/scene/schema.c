@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include "scene/expr.h"
+#include "scene/mesh.h"
 #include "scene/schema_impl.h"
 #include "solver/stability.h"
 
@@ -299,6 +300,7 @@ void sph_scene_destroy(sph_scene *s) {
     sph_expr_destroy(s->bodies[i].velocity.profile);
     for (int c = 0; c < 3; ++c)
       sph_expr_destroy(s->bodies[i].velocity.expr[c]);
+    sph_mesh_destroy(s->bodies[i].shape.mesh);
   }
   free(s->bodies);
   free(s->materials);

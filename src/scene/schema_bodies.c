@@ -7,26 +7,93 @@
 #include <string.h>
 
 #include "scene/expr.h"
+#include "scene/mesh.h"
 #include "scene/schema_impl.h"
+
+/* mesh: {file, units, flip_normals}: the file (relative to the scene's)
+ * read, scaled to metres, checked for an inside and an outward surface */
+static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
+                             sph_error *err) {
+  static const char *const keys[] = {"file", "units", "flip_normals", NULL};
+  static const char *const units[] = {"m", "cm", "mm", "um", "in", "ft", NULL};
+  static const double scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  if (s->dimension != 3)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "a mesh is a 3D shape (this scene is 2D)");
+  const char *file;
+  int flip, u;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  sph_node *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", units, "m", &u, err));
+  SPH_TRY(sph_node_get_bool(g, "flip_normals", 0, 0, &flip, err));
+  if (!file[0] || strlen(file) >= sizeof sh->file)
+    return sph_node_error(fn, err, SPH_ERR_RANGE,
+                          "give the mesh file's name (under %zu bytes)",
+                          sizeof sh->file);
+  snprintf(sh->file, sizeof sh->file, "%s", file);
+  /* relative to the scene file's folder (to the working one for --set) */
+  char path[1024];
+  const char *slash = fn->file ? strrchr(fn->file, '/') : NULL;
+  if (file[0] != '/' && slash && fn->file[0] != '<')
+    snprintf(path, sizeof path, "%.*s/%s", (int)(slash - fn->file), fn->file,
+             file);
+  else
+    snprintf(path, sizeof path, "%s", file);
+  double *tri;
+  size_t n;
+  sph_status st = sph_mesh_read(path, &tri, &n, err);
+  if (st == SPH_OK) {
+    st = sph_mesh_create(&sh->mesh, tri, n, scale[u], flip, err);
+    free(tri);
+  }
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(fn, err, st, "mesh %s", msg); /* "path: why" */
+  }
+  const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
+  double box = 1.0;
+  for (int c = 0; c < 3; ++c) {
+    sh->min[c] = in->lo[c];
+    sh->max[c] = in->hi[c];
+    box *= in->hi[c] - in->lo[c];
+  }
+  if (!(fabs(in->volume) > 1e-9 * box))
+    return sph_node_error(fn, err, SPH_ERR_GEOMETRY,
+                          "mesh %s encloses no volume (%zu triangles, %zu "
+                          "open edges): an open sheet has no inside to fill",
+                          file, in->triangles, in->open_edges);
+  if (in->volume < 0.0)
+    return sph_node_error(
+        fn, err, SPH_ERR_GEOMETRY,
+        "mesh %s: its volume is negative (%.4g m^3): the triangles face "
+        "inwards; %s",
+        file, in->volume,
+        flip ? "remove flip_normals: true" : "set flip_normals: true");
+  return SPH_OK;
+}
 
 static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                               sph_error *err) {
   static const char *const kinds[] = {"box",    "cylinder", "ring", "disc",
-                                      "sphere", "shell",    NULL};
+                                      "sphere", "shell",    "mesh", NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
   SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
   SPH_TRY(sph_schema_one_of(n, kinds, "shape", &which, err));
-  static const sph_shape_kind map[] = {SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER,
-                                       SPH_SHAPE_RING,   SPH_SHAPE_DISC,
-                                       SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL};
+  static const sph_shape_kind map[] = {
+      SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER, SPH_SHAPE_RING, SPH_SHAPE_DISC,
+      SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL,    SPH_SHAPE_MESH};
   memset(sh, 0, sizeof *sh);
   sh->kind = map[which];
   sph_node *g;
   SPH_TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
   int d = s->dimension;
   switch (sh->kind) {
+  case SPH_SHAPE_MESH:
+    return parse_mesh(s, sh, g, err);
   case SPH_SHAPE_BOX: {
     static const char *const keys[] = {"min", "max", NULL};
     SPH_TRY(sph_node_check_keys(g, keys, err));
@@ -125,10 +192,10 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
   SPH_TRY(sph_schema_one_of(n, how, "of count or spacing", &which, err));
   int d = s->dimension;
   if (which == 0) {
-    if (b->shape.kind != SPH_SHAPE_BOX)
+    if (b->shape.kind != SPH_SHAPE_BOX && b->shape.kind != SPH_SHAPE_MESH)
       return sph_node_error(sph_node_child(n, "count"), err, SPH_ERR_ARG,
-                            "particle counts apply to boxes; give a spacing "
-                            "for other shapes");
+                            "particle counts apply to boxes and meshes; give "
+                            "a spacing for other shapes");
     double c[3];
     SPH_TRY(sph_node_get_doubles(n, "count", 1, (size_t)d, c, NULL, err));
     b->lattice = SPH_LATTICE_FACES;
@@ -160,6 +227,10 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
                           "'%s'",
                           dist);
   b->distribution = (sph_distribution)dk;
+  if (dk == SPH_DIST_RELAX && b->shape.kind == SPH_SHAPE_MESH)
+    return sph_node_error(sph_node_child(n, "distribution"), err, SPH_ERR_ARG,
+                          "a mesh body is not relaxed yet: use lattice or "
+                          "jitter");
   if (dk != SPH_DIST_LATTICE) {
     SPH_TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
     if (!(b->jitter >= 0.0 && b->jitter < 0.5))
