@@ -52,6 +52,12 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
     snprintf(msg, sizeof msg, "%s", err->message);
     return sph_node_error(fn, err, st, "mesh %s", msg); /* "path: why" */
   }
+  /* the resolved scene (a run's scene_used.yaml) names it wherever it is */
+  char *abs = realpath(path, NULL);
+  if (abs) {
+    free(fn->value);
+    fn->value = abs;
+  }
   const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
   double box = 1.0;
   for (int c = 0; c < 3; ++c) {

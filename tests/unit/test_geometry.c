@@ -168,6 +168,7 @@ static double offset_measure(const sph_shape *s, int dim, double grow) {
   case SPH_SHAPE_CYLINDER:
     return M_PI * R * R * L;
   case SPH_SHAPE_BOX:
+  case SPH_SHAPE_MESH: /* test_mesh.c */
     break;
   }
   return NAN;
