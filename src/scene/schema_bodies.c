@@ -58,6 +58,7 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
     free(fn->value);
     fn->value = abs;
   }
+  file = sh->file; /* the name as given (fn->value was it) */
   const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
   double box = 1.0;
   for (int c = 0; c < 3; ++c) {
