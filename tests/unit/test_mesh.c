@@ -221,6 +221,47 @@ START_TEST(test_rays_on_edges) {
 }
 END_TEST
 
+/* several shells: the unit cube, a second one apart (moved by 3 in x) and
+ * a cavity inside the first (a cube of side 0.5 about its centre): the
+ * solid they bound, whichever way the cavity's triangles face */
+START_TEST(test_shells) {
+  double *tri;
+  size_t n;
+  sph_error err;
+  ck_assert_int_eq(sph_mesh_read(MESHES "cube.stl", &tri, &n, &err), SPH_OK);
+  double *all = malloc(3 * 9 * n * sizeof *all);
+  for (size_t k = 0; k < 9 * n; ++k) {
+    all[k] = tri[k];
+    all[9 * n + k] = tri[k] + (k % 3 == 0 ? 3.0 : 0.0);
+    all[18 * n + k] = 0.25 + 0.5 * tri[k];
+  }
+  static const double in[][3] = {
+      {0.1, 0.1, 0.1}, {0.9, 0.5, 0.5}, {3.5, 0.5, 0.5}, {3.1, 0.9, 0.2}};
+  static const double out[][3] = {
+      {0.5, 0.5, 0.5}, {0.3, 0.6, 0.7}, {2.0, 0.5, 0.5}, {1.5, 0.5, 0.5}};
+  for (int flip = 0; flip < 2; ++flip) {
+    if (flip) /* the cavity's triangles turned inwards, as it should be */
+      for (size_t t = 2 * n; t < 3 * n; ++t)
+        for (int c = 0; c < 3; ++c) {
+          double x = all[9 * t + 3 + c];
+          all[9 * t + 3 + c] = all[9 * t + 6 + c];
+          all[9 * t + 6 + c] = x;
+        }
+    sph_mesh *m;
+    ck_assert_int_eq(sph_mesh_create(&m, all, 3 * n, 1.0, 0, &err), SPH_OK);
+    for (size_t k = 0; k < sizeof in / sizeof *in; ++k)
+      ck_assert_msg(sph_mesh_inside(m, in[k]), "flip %d point %zu", flip, k);
+    for (size_t k = 0; k < sizeof out / sizeof *out; ++k)
+      ck_assert_msg(!sph_mesh_inside(m, out[k]), "flip %d point %zu", flip, k);
+    ck_assert_double_eq_tol(sph_mesh_get_info(m)->volume,
+                            flip ? 2.0 - 0.125 : 2.125, 1e-12);
+    sph_mesh_destroy(m);
+  }
+  free(all);
+  free(tri);
+}
+END_TEST
+
 /* the error's place: `key` on line 10 (the shape) or 11 (the particles) */
 static void refused(const char *shape, const char *particles, sph_status code,
                     const char *key, const char *fragment) {
@@ -275,6 +316,7 @@ static Suite *mesh_suite(void) {
   tcase_add_test(tc, test_transform_is_the_moved_mesh);
   tcase_add_test(tc, test_threads);
   tcase_add_test(tc, test_rays_on_edges);
+  tcase_add_test(tc, test_shells);
   tcase_add_test(tc, test_bad_input);
   suite_add_tcase(s, tc);
   return s;
