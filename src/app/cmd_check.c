@@ -6,6 +6,7 @@
 #include "app/app_impl.h"
 #include "scene/mesh.h"
 #include "scene/node.h"
+#include "scene/polygon.h"
 #include "scene/scene.h"
 #include "solver/sim.h"
 
@@ -16,14 +17,20 @@ static double peak_rss_mib(void) {
   return (double)ru.ru_maxrss / 1024.0; /* ru_maxrss is in KiB on Linux */
 }
 
-/* a mesh body's surface: size, soundness, and the particles' volume */
-static void print_mesh(const sph_body *body, const sph_particles *ps,
-                       size_t b) {
-  const sph_mesh_info *in = sph_mesh_get_info(body->shape.mesh);
+/* the particles' volume (area in 2D) of body b */
+static double body_volume(const sph_particles *ps, size_t b) {
   double v = 0.0;
   for (size_t i = 0; i < ps->n; ++i)
     if (ps->body[i] == (int32_t)b)
       v += ps->field[SPH_FIELD_VOLUME0][i];
+  return v;
+}
+
+/* a mesh body's surface: size, soundness, and the particles' volume */
+static void print_mesh(const sph_body *body, const sph_particles *ps,
+                       size_t b) {
+  const sph_mesh_info *in = sph_mesh_get_info(body->shape.mesh);
+  double v = body_volume(ps, b);
   printf("  %-16s mesh %s: %zu triangles, %zu open edges, box [%.4g, %.4g, "
          "%.4g] to [%.4g, %.4g, %.4g] m\n",
          "", body->shape.file, in->triangles, in->open_edges, in->lo[0],
@@ -53,6 +60,12 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
            s->materials[body->material].ops->name);
     if (body->shape.kind == SPH_SHAPE_MESH)
       print_mesh(body, ps, b);
+    if (body->shape.kind == SPH_SHAPE_POLYGON) {
+      double v = body_volume(ps, b), A = sph_polygon_area(body->shape.polygon);
+      printf("  %-16s polygon: area %.6g m^2; particles %.6g m^2, %.2f %% of "
+             "it\n",
+             "", A, v, 100.0 * v / A);
+    }
   }
   printf("particles  %zu\n", ps->n);
   printf("terms      %d\n", sim->nterms);

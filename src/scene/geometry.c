@@ -14,6 +14,7 @@
 
 #include "scene/geometry_impl.h"
 #include "scene/mesh.h"
+#include "scene/polygon.h"
 
 /* ---- shapes ------------------------------------------------------------- */
 
@@ -74,6 +75,8 @@ double sph_shape_distance(const sph_shape *s, int dim, const double X[3]) {
   }
   case SPH_SHAPE_MESH: /* the side only */
     return sph_mesh_inside(s->mesh, X) ? -1.0 : 1.0;
+  case SPH_SHAPE_POLYGON:
+    return sph_polygon_inside(s->polygon, X) ? -1.0 : 1.0;
   }
   return INFINITY;
 }
@@ -81,7 +84,8 @@ double sph_shape_distance(const sph_shape *s, int dim, const double X[3]) {
 void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]) {
   for (int c = 0; c < 3; ++c)
     lo[c] = hi[c] = 0.0;
-  if (s->kind == SPH_SHAPE_BOX || s->kind == SPH_SHAPE_MESH) {
+  if (s->kind == SPH_SHAPE_BOX || s->kind == SPH_SHAPE_MESH ||
+      s->kind == SPH_SHAPE_POLYGON) {
     for (int c = 0; c < dim; ++c) {
       lo[c] = s->min[c];
       hi[c] = s->max[c];
@@ -131,6 +135,8 @@ double sph_shape_measure(const sph_shape *s, int dim) {
     return M_PI * s->radius * s->radius * s->length;
   case SPH_SHAPE_MESH:
     return sph_mesh_get_info(s->mesh)->volume;
+  case SPH_SHAPE_POLYGON:
+    return sph_polygon_area(s->polygon);
   }
   return 0.0;
 }
@@ -312,8 +318,8 @@ static void jitter(lattice *L, double X[3]) {
 
 static const char *shape_name(sph_shape_kind kind) {
   static const char *const names[] = {"box",    "cylinder", "ring", "disc",
-                                      "sphere", "shell",    "mesh"};
-  return (int)kind >= 0 && kind <= SPH_SHAPE_MESH ? names[kind] : "shape";
+                                      "sphere", "shell",    "mesh", "polygon"};
+  return (int)kind >= 0 && kind <= SPH_SHAPE_POLYGON ? names[kind] : "shape";
 }
 
 static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
@@ -325,9 +331,12 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          dim);
   if (dim == 2 && (s->kind == SPH_SHAPE_SPHERE || s->kind == SPH_SHAPE_SHELL ||
                    s->kind == SPH_SHAPE_CYLINDER || s->kind == SPH_SHAPE_MESH))
-    return sph_error_set(
-        err, SPH_ERR_GEOMETRY, "body '%s': a %s is a 3D shape; in 2D use a %s",
-        b->name, name, s->kind == SPH_SHAPE_CYLINDER ? "box" : "disc or ring");
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': a %s is a 3D shape; in 2D use a %s",
+                         b->name, name,
+                         s->kind == SPH_SHAPE_CYLINDER ? "box"
+                         : s->kind == SPH_SHAPE_MESH   ? "polygon"
+                                                       : "disc or ring");
   if (dim == 3 && s->kind == SPH_SHAPE_DISC)
     return sph_error_set(err, SPH_ERR_GEOMETRY,
                          "body '%s': a disc is a 2D shape; in 3D use a "
@@ -338,10 +347,18 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          "body '%s': a ring in 3D is a tube and needs a "
                          "positive length, got %g",
                          b->name, s->length);
-  if (s->kind == SPH_SHAPE_MESH && !s->mesh)
-    return sph_error_set(err, SPH_ERR_GEOMETRY, "body '%s': no mesh", b->name);
+  if ((s->kind == SPH_SHAPE_MESH && !s->mesh) ||
+      (s->kind == SPH_SHAPE_POLYGON && !s->polygon))
+    return sph_error_set(err, SPH_ERR_GEOMETRY, "body '%s': no %s", b->name,
+                         name);
+  if (dim == 3 && s->kind == SPH_SHAPE_POLYGON)
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': a polygon is a 2D shape; in 3D use a "
+                         "mesh",
+                         b->name);
   switch (s->kind) {
   case SPH_SHAPE_MESH: /* its bounding box */
+  case SPH_SHAPE_POLYGON:
   case SPH_SHAPE_BOX:
     for (int c = 0; c < dim; ++c)
       if (!(s->max[c] > s->min[c]))

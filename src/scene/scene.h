@@ -27,11 +27,14 @@ typedef enum sph_shape_kind {
   SPH_SHAPE_DISC,     /* 2D: center, radius */
   SPH_SHAPE_SPHERE,   /* 3D: center, radius */
   SPH_SHAPE_SHELL,    /* 3D spherical shell: center, inner/outer radius */
-  SPH_SHAPE_MESH      /* 3D: a closed triangle surface read from a file
+  SPH_SHAPE_MESH,     /* 3D: a closed triangle surface read from a file
                          (scene/mesh.h); min, max its bounding box */
+  SPH_SHAPE_POLYGON   /* 2D: an outline with holes (scene/polygon.h); min,
+                         max its bounding box */
 } sph_shape_kind;
 
-struct sph_mesh; /* see mesh.h */
+struct sph_mesh;    /* see mesh.h */
+struct sph_polygon; /* see polygon.h */
 
 typedef struct sph_shape {
   sph_shape_kind kind;
@@ -39,8 +42,9 @@ typedef struct sph_shape {
   double center[3];
   double axis[3]; /* unit vector (cylinder, tube) */
   double radius, inner_radius, outer_radius, length;
-  struct sph_mesh *mesh; /* owned by the scene */
-  char file[256];        /* the mesh file as the scene names it */
+  struct sph_mesh *mesh;       /* owned by the scene */
+  struct sph_polygon *polygon; /* owned by the scene */
+  char file[256];              /* the mesh file as the scene names it */
 } sph_shape;
 
 typedef enum sph_lattice {

@@ -12,6 +12,7 @@
 
 #include "scene/expr.h"
 #include "scene/mesh.h"
+#include "scene/polygon.h"
 #include "scene/schema_impl.h"
 #include "solver/stability.h"
 
@@ -301,6 +302,7 @@ void sph_scene_destroy(sph_scene *s) {
     for (int c = 0; c < 3; ++c)
       sph_expr_destroy(s->bodies[i].velocity.expr[c]);
     sph_mesh_destroy(s->bodies[i].shape.mesh);
+    sph_polygon_destroy(s->bodies[i].shape.polygon);
   }
   free(s->bodies);
   free(s->materials);

@@ -8,6 +8,7 @@
 
 #include "scene/expr.h"
 #include "scene/mesh.h"
+#include "scene/polygon.h"
 #include "scene/schema_impl.h"
 
 /* mesh: {file, units, flip_normals}: the file (relative to the scene's)
@@ -81,10 +82,70 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
   return SPH_OK;
 }
 
+/* one ring of [x, y] pairs appended to *xy (grown by realloc) */
+static sph_status parse_ring(sph_node *ring, double **xy, size_t *n,
+                             sph_error *err) {
+  if (ring->kind != SPH_NODE_SEQ)
+    return sph_node_error(ring, err, SPH_ERR_TYPE,
+                          "expected a list of points [[x, y], ...]");
+  if (ring->count > 1000000)
+    return sph_node_error(ring, err, SPH_ERR_RANGE,
+                          "%zu points: at most 1e6 a ring", ring->count);
+  double *grown = realloc(*xy, 2 * (*n + ring->count) * sizeof *grown);
+  if (!grown)
+    return sph_error_set(err, SPH_ERR_NOMEM, "polygon");
+  *xy = grown;
+  for (size_t i = 0; i < ring->count; ++i) {
+    sph_node *pt = ring->items[i];
+    if (pt->kind != SPH_NODE_SEQ || pt->count != 2)
+      return sph_node_error(pt, err, SPH_ERR_TYPE, "expected a point [x, y]");
+    for (int c = 0; c < 2; ++c)
+      SPH_TRY(sph_node_as_double(pt->items[c], &grown[2 * *n + c], err));
+    ++*n;
+  }
+  return SPH_OK;
+}
+
+/* polygon: {points: [[x, y], ...], holes: [[[x, y], ...], ...]} */
+static sph_status parse_polygon(sph_scene *s, sph_shape *sh, sph_node *g,
+                                sph_error *err) {
+  static const char *const keys[] = {"points", "holes", NULL};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  if (s->dimension != 2)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "a polygon is a 2D shape (in 3D use a mesh)");
+  sph_node *pts, *holes;
+  SPH_TRY(sph_schema_get_seq(g, "points", 1, &pts, err));
+  SPH_TRY(sph_schema_get_seq(g, "holes", 0, &holes, err));
+  size_t nr = 1 + (holes ? holes->count : 0), n = 0;
+  size_t *start = malloc((nr + 1) * sizeof *start);
+  double *xy = NULL;
+  if (!start)
+    return sph_error_set(err, SPH_ERR_NOMEM, "polygon");
+  start[0] = 0;
+  sph_status st = SPH_OK;
+  for (size_t r = 0; st == SPH_OK && r < nr; ++r) {
+    st = parse_ring(r ? holes->items[r - 1] : pts, &xy, &n, err);
+    start[r + 1] = n;
+  }
+  if (st == SPH_OK &&
+      (st = sph_polygon_create(&sh->polygon, xy, start, nr, err)) != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    st = sph_node_error(g, err, st, "polygon: %s", msg);
+  }
+  free(xy);
+  free(start);
+  if (st == SPH_OK)
+    sph_polygon_bounds(sh->polygon, sh->min, sh->max);
+  return st;
+}
+
 static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                               sph_error *err) {
-  static const char *const kinds[] = {"box",    "cylinder", "ring", "disc",
-                                      "sphere", "shell",    "mesh", NULL};
+  static const char *const kinds[] = {"box",  "cylinder", "ring",
+                                      "disc", "sphere",   "shell",
+                                      "mesh", "polygon",  NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
   SPH_TRY(sph_node_check_keys(n, kinds, err));
@@ -92,7 +153,7 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   SPH_TRY(sph_schema_one_of(n, kinds, "shape", &which, err));
   static const sph_shape_kind map[] = {
       SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER, SPH_SHAPE_RING, SPH_SHAPE_DISC,
-      SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL,    SPH_SHAPE_MESH};
+      SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL,    SPH_SHAPE_MESH, SPH_SHAPE_POLYGON};
   memset(sh, 0, sizeof *sh);
   sh->kind = map[which];
   sph_node *g;
@@ -101,6 +162,8 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   switch (sh->kind) {
   case SPH_SHAPE_MESH:
     return parse_mesh(s, sh, g, err);
+  case SPH_SHAPE_POLYGON:
+    return parse_polygon(s, sh, g, err);
   case SPH_SHAPE_BOX: {
     static const char *const keys[] = {"min", "max", NULL};
     SPH_TRY(sph_node_check_keys(g, keys, err));
@@ -180,11 +243,11 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   int is3d = sh->kind == SPH_SHAPE_SPHERE || sh->kind == SPH_SHAPE_SHELL ||
              sh->kind == SPH_SHAPE_CYLINDER;
   if ((d == 2 && is3d) || (d == 3 && sh->kind == SPH_SHAPE_DISC))
-    return sph_node_error(sph_node_child(n, kinds[which]), err,
-                          SPH_ERR_GEOMETRY,
-                          "a %s does not exist in %dD (2D: box, disc, ring; "
-                          "3D: box, cylinder, ring, sphere, shell)",
-                          kinds[which], d);
+    return sph_node_error(
+        sph_node_child(n, kinds[which]), err, SPH_ERR_GEOMETRY,
+        "a %s does not exist in %dD (2D: box, disc, ring, polygon; "
+        "3D: box, cylinder, ring, sphere, shell, mesh)",
+        kinds[which], d);
   return SPH_OK;
 }
 
@@ -234,10 +297,12 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
                           "'%s'",
                           dist);
   b->distribution = (sph_distribution)dk;
-  if (dk == SPH_DIST_RELAX && b->shape.kind == SPH_SHAPE_MESH)
+  if (dk == SPH_DIST_RELAX &&
+      (b->shape.kind == SPH_SHAPE_MESH || b->shape.kind == SPH_SHAPE_POLYGON))
     return sph_node_error(sph_node_child(n, "distribution"), err, SPH_ERR_ARG,
-                          "a mesh body is not relaxed yet: use lattice or "
-                          "jitter");
+                          "a %s body is not relaxed yet: use lattice or "
+                          "jitter",
+                          b->shape.kind == SPH_SHAPE_MESH ? "mesh" : "polygon");
   if (dk != SPH_DIST_LATTICE) {
     SPH_TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
     if (!(b->jitter >= 0.0 && b->jitter < 0.5))

@@ -169,6 +169,7 @@ static double offset_measure(const sph_shape *s, int dim, double grow) {
     return M_PI * R * R * L;
   case SPH_SHAPE_BOX:
   case SPH_SHAPE_MESH: /* test_mesh.c */
+  case SPH_SHAPE_POLYGON:
     break;
   }
   return NAN;
