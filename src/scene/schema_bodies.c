@@ -8,16 +8,40 @@
 
 #include "scene/expr.h"
 #include "scene/mesh.h"
+#include "scene/outline_read.h"
 #include "scene/polygon.h"
 #include "scene/schema_impl.h"
+
+/* a file the scene names: relative to the scene file's folder (to the
+ * working one for --set) */
+static void file_path(const sph_node *fn, const char *file, char *path,
+                      size_t size) {
+  const char *slash = fn->file ? strrchr(fn->file, '/') : NULL;
+  if (file[0] != '/' && slash && fn->file[0] != '<')
+    snprintf(path, size, "%.*s/%s", (int)(slash - fn->file), fn->file, file);
+  else
+    snprintf(path, size, "%s", file);
+}
+
+/* the resolved scene (a run's scene_used.yaml) names the file wherever it
+ * is read from: its absolute path replaces fn's value */
+static void name_absolute(sph_node *fn, const char *path) {
+  char *abs = realpath(path, NULL);
+  if (abs) {
+    free(fn->value);
+    fn->value = abs;
+  }
+}
+
+static const char *const length_units[] = {"m",  "cm", "mm", "um",
+                                           "in", "ft", NULL};
+static const double length_scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
 
 /* mesh: {file, units, flip_normals}: the file (relative to the scene's)
  * read, scaled to metres, checked for an inside and an outward surface */
 static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
                              sph_error *err) {
   static const char *const keys[] = {"file", "units", "flip_normals", NULL};
-  static const char *const units[] = {"m", "cm", "mm", "um", "in", "ft", NULL};
-  static const double scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
   SPH_TRY(sph_node_check_keys(g, keys, err));
   if (s->dimension != 3)
     return sph_node_error(g, err, SPH_ERR_GEOMETRY,
@@ -26,26 +50,20 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
   int flip, u;
   SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
   sph_node *fn = sph_node_child(g, "file");
-  SPH_TRY(sph_node_get_choice(g, "units", units, "m", &u, err));
+  SPH_TRY(sph_node_get_choice(g, "units", length_units, "m", &u, err));
   SPH_TRY(sph_node_get_bool(g, "flip_normals", 0, 0, &flip, err));
   if (!file[0] || strlen(file) >= sizeof sh->file)
     return sph_node_error(fn, err, SPH_ERR_RANGE,
                           "give the mesh file's name (under %zu bytes)",
                           sizeof sh->file);
   snprintf(sh->file, sizeof sh->file, "%s", file);
-  /* relative to the scene file's folder (to the working one for --set) */
   char path[1024];
-  const char *slash = fn->file ? strrchr(fn->file, '/') : NULL;
-  if (file[0] != '/' && slash && fn->file[0] != '<')
-    snprintf(path, sizeof path, "%.*s/%s", (int)(slash - fn->file), fn->file,
-             file);
-  else
-    snprintf(path, sizeof path, "%s", file);
+  file_path(fn, file, path, sizeof path);
   double *tri;
   size_t n;
   sph_status st = sph_mesh_read(path, &tri, &n, err);
   if (st == SPH_OK) {
-    st = sph_mesh_create(&sh->mesh, tri, n, scale[u], flip, err);
+    st = sph_mesh_create(&sh->mesh, tri, n, length_scale[u], flip, err);
     free(tri);
   }
   if (st != SPH_OK) {
@@ -53,12 +71,7 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
     snprintf(msg, sizeof msg, "%s", err->message);
     return sph_node_error(fn, err, st, "mesh %s", msg); /* "path: why" */
   }
-  /* the resolved scene (a run's scene_used.yaml) names it wherever it is */
-  char *abs = realpath(path, NULL);
-  if (abs) {
-    free(fn->value);
-    fn->value = abs;
-  }
+  name_absolute(fn, path);
   file = sh->file; /* the name as given (fn->value was it) */
   const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
   double box = 1.0;
@@ -141,19 +154,95 @@ static sph_status parse_polygon(sph_scene *s, sph_shape *sh, sph_node *g,
   return st;
 }
 
+/* points [a, b) of xy in reverse order */
+static void reverse_points(double *xy, size_t a, size_t b) {
+  for (; a + 1 < b; ++a, --b)
+    for (int c = 0; c < 2; ++c) {
+      double t = xy[2 * a + c];
+      xy[2 * a + c] = xy[2 * (b - 1) + c];
+      xy[2 * (b - 1) + c] = t;
+    }
+}
+
+/* the ring of largest area first: the outline, the others its holes */
+static void outline_first(double *xy, size_t *start, size_t nr) {
+  size_t best = 0;
+  double most = -1.0;
+  for (size_t r = 0; r < nr; ++r) {
+    double a = 0.0;
+    for (size_t i = start[r]; i < start[r + 1]; ++i) {
+      size_t j = i + 1 < start[r + 1] ? i + 1 : start[r];
+      a += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
+    }
+    if (fabs(a) > most) {
+      most = fabs(a);
+      best = r;
+    }
+  }
+  /* rings [0, best] turned right by ring best's length: three reversals */
+  size_t len = start[best + 1] - start[best], end = start[best + 1];
+  reverse_points(xy, 0, end);
+  reverse_points(xy, 0, len);
+  reverse_points(xy, len, end);
+  for (size_t r = best; r > 0; --r)
+    start[r] = start[r - 1] + len;
+}
+
+/* outline: {file, units}: a CSV or SVG outline (outline_read.c) */
+static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
+                                sph_error *err) {
+  static const char *const keys[] = {"file", "units", NULL};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  if (s->dimension != 2)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "an outline is a 2D shape (in 3D use a mesh)");
+  const char *file;
+  int u;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  sph_node *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", length_units, "m", &u, err));
+  if (!file[0] || strlen(file) >= sizeof sh->file)
+    return sph_node_error(fn, err, SPH_ERR_RANGE,
+                          "give the outline file's name (under %zu bytes)",
+                          sizeof sh->file);
+  snprintf(sh->file, sizeof sh->file, "%s", file);
+  char path[1024];
+  file_path(fn, file, path, sizeof path);
+  double *xy;
+  size_t *start, nr;
+  sph_status st = sph_outline_read(path, &xy, &start, &nr, err);
+  if (st == SPH_OK) {
+    for (size_t i = 0; i < 2 * start[nr]; ++i)
+      xy[i] *= length_scale[u];
+    outline_first(xy, start, nr);
+    st = sph_polygon_create(&sh->polygon, xy, start, nr, err);
+    free(xy);
+    free(start);
+  }
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(fn, err, st, "outline %s", msg);
+  }
+  name_absolute(fn, path);
+  sph_polygon_bounds(sh->polygon, sh->min, sh->max);
+  return SPH_OK;
+}
+
 static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                               sph_error *err) {
-  static const char *const kinds[] = {"box",  "cylinder", "ring",
-                                      "disc", "sphere",   "shell",
-                                      "mesh", "polygon",  NULL};
+  static const char *const kinds[] = {"box",     "cylinder", "ring", "disc",
+                                      "sphere",  "shell",    "mesh", "polygon",
+                                      "outline", NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
   SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
   SPH_TRY(sph_schema_one_of(n, kinds, "shape", &which, err));
   static const sph_shape_kind map[] = {
-      SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER, SPH_SHAPE_RING, SPH_SHAPE_DISC,
-      SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL,    SPH_SHAPE_MESH, SPH_SHAPE_POLYGON};
+      SPH_SHAPE_BOX,  SPH_SHAPE_CYLINDER, SPH_SHAPE_RING,
+      SPH_SHAPE_DISC, SPH_SHAPE_SPHERE,   SPH_SHAPE_SHELL,
+      SPH_SHAPE_MESH, SPH_SHAPE_POLYGON,  SPH_SHAPE_POLYGON};
   memset(sh, 0, sizeof *sh);
   sh->kind = map[which];
   sph_node *g;
@@ -163,7 +252,8 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   case SPH_SHAPE_MESH:
     return parse_mesh(s, sh, g, err);
   case SPH_SHAPE_POLYGON:
-    return parse_polygon(s, sh, g, err);
+    return which == 8 ? parse_outline(s, sh, g, err)
+                      : parse_polygon(s, sh, g, err);
   case SPH_SHAPE_BOX: {
     static const char *const keys[] = {"min", "max", NULL};
     SPH_TRY(sph_node_check_keys(g, keys, err));

@@ -177,6 +177,81 @@ START_TEST(test_bad_input) {
 }
 END_TEST
 
+/* text into a file named `name` under /tmp; its path into path[128] */
+static void put(char *path, const char *name, const char *text) {
+  snprintf(path, 128, "/tmp/sph_outline_%d_%s", (int)getpid(), name);
+  FILE *f = fopen(path, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs(text, f);
+  fclose(f);
+}
+
+static const char *const hole =
+    "{polygon: {points: [[0, 0], [1, 0], [1, 1], [0, 1]], holes: [[[0.25, "
+    "0.25], [0.75, 0.25], [0.75, 0.75], [0.25, 0.75]]]}}";
+
+/* CSV (the hole first: the largest ring is the outline) and SVG (y down,
+ * a path and a rect) in mm give the polygon's particles */
+START_TEST(test_outline_files) {
+  char csv[128], svg[128], shape[256];
+  put(csv, "a.csv",
+      "# a square with a hole, mm\nx, y\n250, 250\n750, 250\n750, "
+      "750\n250, 750\n\n0, 0\n1000, 0\n1000, 1000\n0, 1000\n");
+  put(svg, "a.svg",
+      "<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\">\n"
+      "<path d=\"M 0 0 H 1000 V -1000 h -1000 Z\"/>\n"
+      "<rect x=\"250\" y=\"-750\" width=\"500\" height=\"500\"/>\n</svg>\n");
+  sph_particles *ref = particles_of(hole, "{spacing: 0.05}", NULL);
+  ck_assert_uint_eq(ref->n, 300);
+  const char *files[] = {csv, svg};
+  for (int k = 0; k < 2; ++k) {
+    snprintf(shape, sizeof shape, "{outline: {file: %s, units: mm}}", files[k]);
+    sph_particles *o = particles_of(shape, "{spacing: 0.05}", NULL);
+    ck_assert_uint_eq(o->n, ref->n);
+    ck_assert_msg(!memcmp(ref->field[SPH_FIELD_POSITION0],
+                          o->field[SPH_FIELD_POSITION0],
+                          3 * o->n * sizeof(double)),
+                  "%s", files[k]);
+    sph_particles_destroy(o);
+  }
+  sph_particles_destroy(ref);
+  unlink(csv);
+  unlink(svg);
+}
+END_TEST
+
+START_TEST(test_outline_bad_files) {
+  static const struct {
+    const char *name, *text, *fragment;
+    sph_status code;
+  } bad[] = {{"b.csv", "0, 0\n1, 0\n1, one\n", "b.csv:3: expected x, y",
+              SPH_ERR_SYNTAX},
+             {"c.csv", "# nothing\n", "no points", SPH_ERR_GEOMETRY},
+             {"d.svg", "<svg><path d=\"M 0 0 C 1 1 2 2 3 3 Z\"/></svg>",
+              "d.svg:1: a path with curves", SPH_ERR_SYNTAX},
+             {"e.svg",
+              "<svg>\n<g transform=\"scale(2)\"><rect width=\"1\" "
+              "height=\"1\"/></g></svg>",
+              "e.svg:2: a transform attribute", SPH_ERR_SYNTAX},
+             {"f.svg", "<svg><rect width=\"1\" height=\"1\"></svg>",
+              "not SVG that sph can read", SPH_ERR_SYNTAX},
+             {"g.svg", "<svg><text>no shapes</text></svg>", "no polygon",
+              SPH_ERR_GEOMETRY},
+             {"h.dxf", "0\nSECTION\n", "an outline is a .svg or a .csv file",
+              SPH_ERR_IO},
+             {"i.svg", "<svg><polygon points=\"0,0 1,0 1\"/></svg>",
+              "an x without its y", SPH_ERR_SYNTAX}};
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k) {
+    char path[128], shape[256];
+    put(path, bad[k].name, bad[k].text);
+    snprintf(shape, sizeof shape, "{outline: {file: %s}}", path);
+    refused(2, shape, "{spacing: 0.1}", bad[k].code,
+            "bodies[0].shape.outline.file", bad[k].fragment);
+    unlink(path);
+  }
+}
+END_TEST
+
 static Suite *polygon_suite(void) {
   Suite *s = suite_create("polygon");
   TCase *tc = tcase_create("core");
@@ -185,6 +260,8 @@ static Suite *polygon_suite(void) {
   tcase_add_test(tc, test_transform_is_the_moved_outline);
   tcase_add_test(tc, test_rays_through_vertices);
   tcase_add_test(tc, test_bad_input);
+  tcase_add_test(tc, test_outline_files);
+  tcase_add_test(tc, test_outline_bad_files);
   suite_add_tcase(s, tc);
   return s;
 }
