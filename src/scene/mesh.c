@@ -378,3 +378,67 @@ sph_status sph_mesh_inside_lattice(const sph_mesh *m, const long n[3],
   free(bufs);
   return SPH_OK;
 }
+
+/* ---- distance ------------------------------------------------------------ */
+
+static double dot3(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* squared distance from p to triangle abc (closest point by its Voronoi
+ * regions, Ericson, Real-Time Collision Detection, sec. 5.1.5) */
+static double tri_dist2(const double p[3], const double *T) {
+  const double *a = T, *b = T + 3, *c = T + 6;
+  double ab[3], ac[3], ap[3], bp[3], cp[3], q[3];
+  for (int k = 0; k < 3; ++k) {
+    ab[k] = b[k] - a[k];
+    ac[k] = c[k] - a[k];
+    ap[k] = p[k] - a[k];
+    bp[k] = p[k] - b[k];
+    cp[k] = p[k] - c[k];
+  }
+  double d1 = dot3(ab, ap), d2 = dot3(ac, ap), d3 = dot3(ab, bp),
+         d4 = dot3(ac, bp), d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+  double u = 0.0, w = 0.0; /* q = a + u ab + w ac */
+  if (d1 <= 0.0 && d2 <= 0.0) {
+  } else if (d3 >= 0.0 && d4 <= d3) {
+    u = 1.0;
+  } else if (d6 >= 0.0 && d5 <= d6) {
+    w = 1.0;
+  } else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    u = d1 / (d1 - d3);
+  } else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    w = d2 / (d2 - d6);
+  } else if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+    w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    u = 1.0 - w;
+  } else {
+    double den = va + vb + vc;
+    u = den != 0.0 ? vb / den : 0.0;
+    w = den != 0.0 ? vc / den : 0.0;
+  }
+  double d2sum = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    q[k] = a[k] + u * ab[k] + w * ac[k] - p[k];
+    d2sum += q[k] * q[k];
+  }
+  return d2sum;
+}
+
+double sph_mesh_distance(const sph_mesh *m, const double X[3]) {
+  double best = INFINITY;
+  for (size_t t = 0; t < m->n; ++t) {
+    const double *T = m->tri + 9 * t;
+    double out = 0.0; /* to the triangle's box: a lower bound */
+    for (int c = 0; c < 3; ++c) {
+      double lo = fmin(T[c], fmin(T[3 + c], T[6 + c]));
+      double hi = fmax(T[c], fmax(T[3 + c], T[6 + c]));
+      double d = X[c] < lo ? lo - X[c] : X[c] > hi ? X[c] - hi : 0.0;
+      out += d * d;
+    }
+    if (out < best)
+      best = fmin(best, tri_dist2(X, T));
+  }
+  return sqrt(best);
+}

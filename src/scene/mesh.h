@@ -45,6 +45,10 @@ const sph_mesh_info *sph_mesh_get_info(const sph_mesh *m);
  * surface an odd number of times beyond X). */
 int sph_mesh_inside(const sph_mesh *m, const double X[3]);
 
+/* The distance from X to the nearest triangle (every triangle's box looked
+ * at: for the small meshes of selections). */
+double sph_mesh_distance(const sph_mesh *m, const double X[3]);
+
 /* The same for every point of a lattice: point (i, j, k) is
  * (x[0][i], x[1][j], x[2][k]), n[c] values on axis c, each axis ascending;
  * inside[(i n1 + j) n2 + k] set to 0 or 1. Rows in parallel (OpenMP), the

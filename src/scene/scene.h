@@ -109,8 +109,10 @@ typedef enum sph_select_kind {
   SPH_SELECT_PLANE, /* |X . normal - at| <= tolerance (world frame) */
   SPH_SELECT_BOX,   /* min <= X <= max (inclusive, with tolerance; in the
                        frame of `body` when it names one) */
-  SPH_SELECT_FACE   /* the side of a body's bounding box in its frame: body,
+  SPH_SELECT_FACE,  /* the side of a body's bounding box in its frame: body,
                        axis, sign */
+  SPH_SELECT_NEAR   /* within `tolerance` of a mesh's triangles (in the frame
+                       of `body` when it names one) */
 } sph_select_kind;
 
 typedef struct sph_selection {
@@ -120,8 +122,9 @@ typedef struct sph_selection {
   double at;
   double tolerance; /* default: half the body spacing */
   double min[3], max[3];
-  int body; /* -1: all bodies */
-  int side; /* -1 or +1 for FACE */
+  int body;              /* -1: all bodies */
+  int side;              /* -1 or +1 for FACE */
+  struct sph_mesh *near; /* NEAR; owned by the scene */
 } sph_selection;
 
 typedef enum sph_condition_kind {

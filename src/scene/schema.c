@@ -306,6 +306,8 @@ void sph_scene_destroy(sph_scene *s) {
   }
   free(s->bodies);
   free(s->materials);
+  for (size_t i = 0; i < s->nboundaries; ++i)
+    sph_mesh_destroy(s->boundaries[i].select.near);
   free(s->boundaries);
   free(s->contact.walls);
   free(s->output.probes);

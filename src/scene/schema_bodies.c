@@ -14,8 +14,8 @@
 
 /* a file the scene names: relative to the scene file's folder (to the
  * working one for --set) */
-static void file_path(const sph_node *fn, const char *file, char *path,
-                      size_t size) {
+void sph_schema_file_path(const sph_node *fn, const char *file, char *path,
+                          size_t size) {
   const char *slash = fn->file ? strrchr(fn->file, '/') : NULL;
   if (file[0] != '/' && slash && fn->file[0] != '<')
     snprintf(path, size, "%.*s/%s", (int)(slash - fn->file), fn->file, file);
@@ -25,7 +25,7 @@ static void file_path(const sph_node *fn, const char *file, char *path,
 
 /* the resolved scene (a run's scene_used.yaml) names the file wherever it
  * is read from: its absolute path replaces fn's value */
-static void name_absolute(sph_node *fn, const char *path) {
+void sph_schema_name_absolute(sph_node *fn, const char *path) {
   char *abs = realpath(path, NULL);
   if (abs) {
     free(fn->value);
@@ -33,9 +33,9 @@ static void name_absolute(sph_node *fn, const char *path) {
   }
 }
 
-static const char *const length_units[] = {"m",  "cm", "mm", "um",
-                                           "in", "ft", NULL};
-static const double length_scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
+const char *const sph_length_units[] = {"m",  "cm", "mm", "um",
+                                        "in", "ft", NULL};
+const double sph_length_scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
 
 /* mesh: {file, units, flip_normals}: the file (relative to the scene's)
  * read, scaled to metres, checked for an inside and an outward surface */
@@ -50,7 +50,7 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
   int flip, u;
   SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
   sph_node *fn = sph_node_child(g, "file");
-  SPH_TRY(sph_node_get_choice(g, "units", length_units, "m", &u, err));
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
   SPH_TRY(sph_node_get_bool(g, "flip_normals", 0, 0, &flip, err));
   if (!file[0] || strlen(file) >= sizeof sh->file)
     return sph_node_error(fn, err, SPH_ERR_RANGE,
@@ -58,12 +58,12 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
                           sizeof sh->file);
   snprintf(sh->file, sizeof sh->file, "%s", file);
   char path[1024];
-  file_path(fn, file, path, sizeof path);
+  sph_schema_file_path(fn, file, path, sizeof path);
   double *tri;
   size_t n;
   sph_status st = sph_mesh_read(path, &tri, &n, err);
   if (st == SPH_OK) {
-    st = sph_mesh_create(&sh->mesh, tri, n, length_scale[u], flip, err);
+    st = sph_mesh_create(&sh->mesh, tri, n, sph_length_scale[u], flip, err);
     free(tri);
   }
   if (st != SPH_OK) {
@@ -71,7 +71,7 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
     snprintf(msg, sizeof msg, "%s", err->message);
     return sph_node_error(fn, err, st, "mesh %s", msg); /* "path: why" */
   }
-  name_absolute(fn, path);
+  sph_schema_name_absolute(fn, path);
   file = sh->file; /* the name as given (fn->value was it) */
   const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
   double box = 1.0;
@@ -200,20 +200,20 @@ static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
   int u;
   SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
   sph_node *fn = sph_node_child(g, "file");
-  SPH_TRY(sph_node_get_choice(g, "units", length_units, "m", &u, err));
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
   if (!file[0] || strlen(file) >= sizeof sh->file)
     return sph_node_error(fn, err, SPH_ERR_RANGE,
                           "give the outline file's name (under %zu bytes)",
                           sizeof sh->file);
   snprintf(sh->file, sizeof sh->file, "%s", file);
   char path[1024];
-  file_path(fn, file, path, sizeof path);
+  sph_schema_file_path(fn, file, path, sizeof path);
   double *xy;
   size_t *start, nr;
   sph_status st = sph_outline_read(path, &xy, &start, &nr, err);
   if (st == SPH_OK) {
     for (size_t i = 0; i < 2 * start[nr]; ++i)
-      xy[i] *= length_scale[u];
+      xy[i] *= sph_length_scale[u];
     outline_first(xy, start, nr);
     st = sph_polygon_create(&sh->polygon, xy, start, nr, err);
     free(xy);
@@ -224,7 +224,7 @@ static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
     snprintf(msg, sizeof msg, "%s", err->message);
     return sph_node_error(fn, err, st, "outline %s", msg);
   }
-  name_absolute(fn, path);
+  sph_schema_name_absolute(fn, path);
   sph_polygon_bounds(sh->polygon, sh->min, sh->max);
   return SPH_OK;
 }

@@ -51,6 +51,20 @@ done
 (cd / && "$sph" check "$work/mesh/scene_used.yaml") >/dev/null 2>"$work/err" && ok ||
   bad "scene_used.yaml: $(cat "$work/err")"
 
+# a boundary near a mesh face selects what the plane of that face does
+sed 's|select: {plane: {axis: y, at: 0}}|select: {plane: {axis: z, at: 1}}|' \
+  "$work/case/mesh.yaml" >"$work/case/plane.yaml"
+sed 's|select: {plane: {axis: y, at: 0}}|select: {near: {file: parts/cube_top.stl}}|' \
+  "$work/case/mesh.yaml" >"$work/case/near.yaml"
+"$sph" run "$work/case/plane.yaml" --out "$work/plane" --quiet >/dev/null 2>&1 &&
+  "$sph" run "$work/case/near.yaml" --out "$work/near" --quiet >/dev/null 2>"$work/err" || bad "near runs: $(cat "$work/err")"
+cmp -s "$work/plane/cube_0002.vtp" "$work/near/cube_0002.vtp" && ok || bad "near: not the plane's run"
+grep -qF "distance: 0.0833333" "$work/near/scene_used.yaml" && ok || bad "near: no default distance in scene_used.yaml"
+sed 's|parts/cube_top.stl|parts/nothing.stl|' "$work/case/near.yaml" >"$work/case/near_bad.yaml"
+"$sph" check "$work/case/near_bad.yaml" >/dev/null 2>"$work/err"
+[ $? -eq 2 ] && grep -qF "near_bad.yaml:13:" "$work/err" && grep -qF "parts/nothing.stl: no such file" "$work/err" && ok ||
+  bad "near, missing file: $(cat "$work/err")"
+
 # refused: exit 2 at the file key (line 9, column 30), nothing written
 refuse() { # FILE_OR_KEY=VALUE EXPECTED
   sed "s|parts/cube.stl|$1|" "$work/case/mesh.yaml" >"$work/case/bad.yaml"

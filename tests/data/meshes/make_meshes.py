@@ -9,6 +9,8 @@ anywhere: the files land beside this script). Made here, public domain
   cube_dup_flip.stl one triangle duplicated, another flipped (13)
   cube_inverted.stl every triangle flipped (negative volume)
   sheet.stl         an open square sheet (no inside)
+  cube_top.stl      the unit cube's face z = 1 alone (2 triangles: a
+                    selection's surface)
   ell.stl           an L-shaped prism (non-convex), 20 triangles
   ell_moved.stl     the same turned 90 degrees about z, moved by (2, 1, 0.5)
   icosphere.obj     a sphere of radius 0.5 about (0.5, 0.5, 0.5), 1280
@@ -141,6 +143,7 @@ def main():
     dup.append(c[0])
     write_ascii(out("cube_dup_flip.stl"), dup)
     write_ascii(out("cube_inverted.stl"), [flip(t) for t in c])
+    write_ascii(out("cube_top.stl"), c[2:4])
     write_ascii(out("sheet.stl"), quad((0, 0, 0.5), (1, 0, 0.5), (1, 1, 0.5), (0, 1, 0.5)))
     e = ell()
     assert abs(volume(e) - 0.375) < 1e-15, volume(e)
