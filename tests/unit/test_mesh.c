@@ -212,6 +212,13 @@ START_TEST(test_rays_on_edges) {
     ck_assert_msg(!sph_mesh_inside(m, out[k]), "point %zu", k);
   const sph_mesh_info *info = sph_mesh_get_info(m);
   ck_assert_double_eq(info->volume, 1.0);
+  /* distances: to a face, an edge, a corner, and inside */
+  static const double X[][4] = {{0.5, 0.5, 1.5, 0.5},
+                                {2.0, 0.5, 2.0, M_SQRT2},
+                                {-1.0, -1.0, -1.0, 1.7320508075688772},
+                                {0.5, 0.5, 0.75, 0.25}};
+  for (int k = 0; k < 4; ++k)
+    ck_assert_double_eq_tol(sph_mesh_distance(m, X[k]), X[k][3], 1e-15);
   sph_mesh_destroy(m);
   ck_assert_int_eq(sph_mesh_create(&m, tri, n, 1.0, 1, &err), SPH_OK);
   ck_assert_double_eq(sph_mesh_get_info(m)->volume, -1.0);
