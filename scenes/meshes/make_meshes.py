@@ -4,6 +4,9 @@ domain, CC0: made here, no third-party data):
   oring.obj  an O-ring: a torus about the y axis, centre line radius 10 mm,
              cross-section radius 2 mm (a 24 x 4 mm seal), 64 x 24 segments,
              in millimetres (the scene reads it with units: mm)
+  dogbone.svg a flat tensile specimen (after ISO 37 type 2, simplified to
+             straight tapers): 75 mm long, 12.5 mm wide grips, a 25 mm
+             gauge 4 mm wide, as an SVG path in mm
 Run: scenes/meshes/make_meshes.py"""
 import math
 import os
@@ -37,7 +40,22 @@ def volume(v, f):
     return s / 6.0
 
 
+def dogbone():
+    # half outline, x >= 0 (mm): grip end, grip, taper, gauge
+    half = [(37.5, 6.25), (25.0, 6.25), (12.5, 2.0)]
+    pts = [(x, y) for x, y in half] + [(-x, y) for x, y in reversed(half)]
+    pts += [(-x, -y) for x, y in half] + [(x, -y) for x, y in reversed(half)]
+    d = "M " + " L ".join("%g %g" % (x, -y) for x, y in pts) + " Z"
+    with open(os.path.join(HERE, "dogbone.svg"), "w") as out:
+        out.write('<?xml version="1.0"?>\n<!-- tensile specimen, mm '
+                  '(scenes/meshes/make_meshes.py; CC0) -->\n'
+                  '<svg xmlns="http://www.w3.org/2000/svg" viewBox="-40 -10 80 20">\n'
+                  '  <path d="%s"/>\n</svg>\n' % d)
+    print("dogbone.svg: %d points" % len(pts))
+
+
 def main():
+    dogbone()
     v, f = torus(10.0, 2.0, 64, 24)
     vol = volume(v, f)
     assert vol > 0, "the triangles must face outwards"
