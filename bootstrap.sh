@@ -25,6 +25,7 @@ packages=(
   # Python package's vtkmodules are VTK's own readers, which validate the
   # files we write (tests); it conflicts with python3-vtk9, which it replaces
   paraview python3-paraview xvfb xauth  # xvfb-run needs xauth (a Recommends)
+  libassimp-dev     # bodies from mesh files: STL, OBJ, PLY... (optional: without it mesh scenes are refused)
   python3-numpy     # the sph Python package's field arrays (python/sph)
   python3-pytest    # the Python package's tests (tests/python)
   clang-format      # formatting is a test

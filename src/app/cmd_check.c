@@ -4,7 +4,9 @@
 #include <sys/resource.h>
 
 #include "app/app_impl.h"
+#include "scene/mesh.h"
 #include "scene/node.h"
+#include "scene/polygon.h"
 #include "scene/scene.h"
 #include "solver/device.h"
 #include "solver/sim.h"
@@ -14,6 +16,29 @@ static double peak_rss_mib(void) {
   if (getrusage(RUSAGE_SELF, &ru) != 0)
     return 0.0;
   return (double)ru.ru_maxrss / 1024.0; /* ru_maxrss is in KiB on Linux */
+}
+
+/* the particles' volume (area in 2D) of body b */
+static double body_volume(const sph_particles *ps, size_t b) {
+  double v = 0.0;
+  for (size_t i = 0; i < ps->n; ++i)
+    if (ps->body[i] == (int32_t)b)
+      v += ps->field[SPH_FIELD_VOLUME0][i];
+  return v;
+}
+
+/* a mesh body's surface: size, soundness, and the particles' volume */
+static void print_mesh(const sph_body *body, const sph_particles *ps,
+                       size_t b) {
+  const sph_mesh_info *in = sph_mesh_get_info(body->shape.mesh);
+  double v = body_volume(ps, b);
+  printf("  %-16s mesh %s: %zu triangles, %zu open edges, box [%.4g, %.4g, "
+         "%.4g] to [%.4g, %.4g, %.4g] m\n",
+         "", body->shape.file, in->triangles, in->open_edges, in->lo[0],
+         in->lo[1], in->lo[2], in->hi[0], in->hi[1], in->hi[2]);
+  printf("  %-16s volume %.6g m^3 (signed); particles %.6g m^3, %.2f %% of "
+         "it\n",
+         "", in->volume, v, 100.0 * v / in->volume);
 }
 
 static void print_plan(const sph_scene *s, sph_sim *sim) {
@@ -34,6 +59,14 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
     printf("  %-16s %8zu particles, dp = %.4g m, material %s (%s)\n",
            body->name, count, body->spacing, s->materials[body->material].name,
            s->materials[body->material].ops->name);
+    if (body->shape.kind == SPH_SHAPE_MESH)
+      print_mesh(body, ps, b);
+    if (body->shape.kind == SPH_SHAPE_POLYGON) {
+      double v = body_volume(ps, b), A = sph_polygon_area(body->shape.polygon);
+      printf("  %-16s polygon: area %.6g m^2; particles %.6g m^2, %.2f %% of "
+             "it\n",
+             "", A, v, 100.0 * v / A);
+    }
   }
   printf("particles  %zu\n", ps->n);
   printf("terms      %d\n", sim->nterms);

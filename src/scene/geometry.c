@@ -13,6 +13,8 @@
 #include <string.h>
 
 #include "scene/geometry_impl.h"
+#include "scene/mesh.h"
+#include "scene/polygon.h"
 
 /* ---- shapes ------------------------------------------------------------- */
 
@@ -71,6 +73,10 @@ double sph_shape_distance(const sph_shape *s, int dim, const double X[3]) {
     axial_coords(s, X, &rho, &along);
     return combine(rho - s->radius, fmax(-along, along - s->length));
   }
+  case SPH_SHAPE_MESH: /* the side only */
+    return sph_mesh_inside(s->mesh, X) ? -1.0 : 1.0;
+  case SPH_SHAPE_POLYGON:
+    return sph_polygon_inside(s->polygon, X) ? -1.0 : 1.0;
   }
   return INFINITY;
 }
@@ -78,7 +84,8 @@ double sph_shape_distance(const sph_shape *s, int dim, const double X[3]) {
 void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]) {
   for (int c = 0; c < 3; ++c)
     lo[c] = hi[c] = 0.0;
-  if (s->kind == SPH_SHAPE_BOX) {
+  if (s->kind == SPH_SHAPE_BOX || s->kind == SPH_SHAPE_MESH ||
+      s->kind == SPH_SHAPE_POLYGON) {
     for (int c = 0; c < dim; ++c) {
       lo[c] = s->min[c];
       hi[c] = s->max[c];
@@ -126,6 +133,10 @@ double sph_shape_measure(const sph_shape *s, int dim) {
   }
   case SPH_SHAPE_CYLINDER:
     return M_PI * s->radius * s->radius * s->length;
+  case SPH_SHAPE_MESH:
+    return sph_mesh_get_info(s->mesh)->volume;
+  case SPH_SHAPE_POLYGON:
+    return sph_polygon_area(s->polygon);
   }
   return 0.0;
 }
@@ -175,7 +186,8 @@ typedef struct lattice {
   int dim, faces, box;
   long n[3];
   double lo[3], h[3], vol;
-  uint64_t state; /* the jitter's stream */
+  uint64_t state;        /* the jitter's stream */
+  unsigned char *inside; /* a mesh's: which lattice points it holds */
 } lattice;
 
 static sph_status lattice_faces(lattice *L, sph_error *err) {
@@ -223,6 +235,10 @@ static sph_status lattice_cells(lattice *L, sph_error *err) {
 static int lattice_point(const lattice *L, const long idx[3], double X[3],
                          double *vol) {
   const sph_shape *s = &L->b->shape;
+  int in = !L->inside ||
+           L->inside[((size_t)idx[0] * (size_t)L->n[1] + (size_t)idx[1]) *
+                         (size_t)L->n[2] +
+                     (size_t)idx[2]];
   X[0] = X[1] = X[2] = 0.0;
   if (L->faces) {
     *vol = 1.0;
@@ -232,12 +248,47 @@ static int lattice_point(const lattice *L, const long idx[3], double X[3],
                                    : s->min[c] + (double)idx[c] * L->h[c];
       *vol *= (idx[c] == 0 || idx[c] == L->n[c] - 1) ? 0.5 * L->h[c] : L->h[c];
     }
-    return 1;
+    return in;
   }
   *vol = L->vol;
   for (int c = 0; c < L->dim; ++c)
     X[c] = L->lo[c] + ((double)idx[c] + 0.5) * L->h[c];
+  if (L->inside)
+    return in;
   return L->box || sph_shape_distance(s, L->dim, X) < 0.0;
+}
+
+/* a mesh's lattice, classified at once (a face lattice's points moved
+ * towards the box centre by 1e-9 of the way: those on the box's faces are
+ * in when the surface holds them) */
+static sph_status lattice_mesh(lattice *L, sph_error *err) {
+  const sph_shape *s = &L->b->shape;
+  double *x[3] = {NULL, NULL, NULL};
+  size_t total = (size_t)L->n[0] * (size_t)L->n[1] * (size_t)L->n[2];
+  L->inside = malloc(total);
+  sph_status st = L->inside ? SPH_OK
+                            : sph_error_set(err, SPH_ERR_NOMEM,
+                                            "body '%s': %zu lattice points",
+                                            L->b->name, total);
+  for (int c = 0; st == SPH_OK && c < 3; ++c) {
+    if (!(x[c] = malloc((size_t)L->n[c] * sizeof *x[c]))) {
+      st = sph_error_set(err, SPH_ERR_NOMEM, "lattice");
+      break;
+    }
+    double mid = 0.5 * (s->min[c] + s->max[c]);
+    for (long i = 0; i < L->n[c]; ++i) {
+      double X = L->faces ? (i == L->n[c] - 1 ? s->max[c]
+                                              : s->min[c] + (double)i * L->h[c])
+                          : L->lo[c] + ((double)i + 0.5) * L->h[c];
+      x[c][i] = L->faces ? X + 1e-9 * (mid - X) : X;
+    }
+  }
+  if (st == SPH_OK)
+    st = sph_mesh_inside_lattice(s->mesh, L->n, (const double *const *)x,
+                                 L->inside, err);
+  for (int c = 0; c < 3; ++c)
+    free(x[c]);
+  return st;
 }
 
 /* ---- jitter -------------------------------------------------------------- */
@@ -266,9 +317,9 @@ static void jitter(lattice *L, double X[3]) {
 /* ---- bodies -------------------------------------------------------------- */
 
 static const char *shape_name(sph_shape_kind kind) {
-  static const char *const names[] = {"box",  "cylinder", "ring",
-                                      "disc", "sphere",   "shell"};
-  return (int)kind >= 0 && kind <= SPH_SHAPE_SHELL ? names[kind] : "shape";
+  static const char *const names[] = {"box",    "cylinder", "ring", "disc",
+                                      "sphere", "shell",    "mesh", "polygon"};
+  return (int)kind >= 0 && kind <= SPH_SHAPE_POLYGON ? names[kind] : "shape";
 }
 
 static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
@@ -279,10 +330,13 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          "body '%s': dimension must be 2 or 3, got %d", b->name,
                          dim);
   if (dim == 2 && (s->kind == SPH_SHAPE_SPHERE || s->kind == SPH_SHAPE_SHELL ||
-                   s->kind == SPH_SHAPE_CYLINDER))
-    return sph_error_set(
-        err, SPH_ERR_GEOMETRY, "body '%s': a %s is a 3D shape; in 2D use a %s",
-        b->name, name, s->kind == SPH_SHAPE_CYLINDER ? "box" : "disc or ring");
+                   s->kind == SPH_SHAPE_CYLINDER || s->kind == SPH_SHAPE_MESH))
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': a %s is a 3D shape; in 2D use a %s",
+                         b->name, name,
+                         s->kind == SPH_SHAPE_CYLINDER ? "box"
+                         : s->kind == SPH_SHAPE_MESH   ? "polygon"
+                                                       : "disc or ring");
   if (dim == 3 && s->kind == SPH_SHAPE_DISC)
     return sph_error_set(err, SPH_ERR_GEOMETRY,
                          "body '%s': a disc is a 2D shape; in 3D use a "
@@ -293,7 +347,18 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          "body '%s': a ring in 3D is a tube and needs a "
                          "positive length, got %g",
                          b->name, s->length);
+  if ((s->kind == SPH_SHAPE_MESH && !s->mesh) ||
+      (s->kind == SPH_SHAPE_POLYGON && !s->polygon))
+    return sph_error_set(err, SPH_ERR_GEOMETRY, "body '%s': no %s", b->name,
+                         name);
+  if (dim == 3 && s->kind == SPH_SHAPE_POLYGON)
+    return sph_error_set(err, SPH_ERR_GEOMETRY,
+                         "body '%s': a polygon is a 2D shape; in 3D use a "
+                         "mesh",
+                         b->name);
   switch (s->kind) {
+  case SPH_SHAPE_MESH: /* its bounding box */
+  case SPH_SHAPE_POLYGON:
   case SPH_SHAPE_BOX:
     for (int c = 0; c < dim; ++c)
       if (!(s->max[c] > s->min[c]))
@@ -328,10 +393,10 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          b->name, name, s->axis[0], s->axis[1], s->axis[2],
                          s->length);
   if (b->lattice == SPH_LATTICE_FACES) {
-    if (s->kind != SPH_SHAPE_BOX)
+    if (s->kind != SPH_SHAPE_BOX && s->kind != SPH_SHAPE_MESH)
       return sph_error_set(err, SPH_ERR_GEOMETRY,
-                           "body '%s': particle counts apply to boxes; give "
-                           "a spacing for a %s",
+                           "body '%s': particle counts apply to boxes and "
+                           "meshes; give a spacing for a %s",
                            b->name, name);
     for (int c = 0; c < dim; ++c)
       if (b->count[c] < 2)
@@ -364,7 +429,8 @@ sph_status sph_body_visit(const sph_body *b, int dim, sph_point_fn fn,
                .n = {1, 1, 1},
                .state = (uint64_t)b->seed};
   SPH_TRY(L.faces ? lattice_faces(&L, err) : lattice_cells(&L, err));
-  sph_status st = SPH_OK;
+  sph_status st =
+      b->shape.kind == SPH_SHAPE_MESH ? lattice_mesh(&L, err) : SPH_OK;
   int jittered = b->distribution != SPH_DIST_LATTICE;
   long idx[3];
   for (idx[0] = 0; st == SPH_OK && idx[0] < L.n[0]; ++idx[0])
@@ -378,6 +444,12 @@ sph_status sph_body_visit(const sph_body *b, int dim, sph_point_fn fn,
         st = fn(ctx, X, vol, err);
         *n += st == SPH_OK;
       }
+  free(L.inside);
+  if (st == SPH_OK && *n == 0 && b->shape.kind == SPH_SHAPE_MESH)
+    st = sph_error_set(err, SPH_ERR_GEOMETRY,
+                       "body '%s' has no particles: no lattice point (spacing "
+                       "%g) is inside the mesh %s",
+                       b->name, b->spacing, b->shape.file);
   if (st == SPH_OK && *n == 0)
     st = sph_error_set(err, SPH_ERR_GEOMETRY,
                        "body '%s' has no particles: spacing %g is larger than "

@@ -87,6 +87,9 @@ static int shape_walls(const sph_shape *s, int dim, const double X[3],
     }
     return k;
   }
+  case SPH_SHAPE_MESH: /* not relaxed (the scene refuses it) */
+  case SPH_SHAPE_POLYGON:
+    return 0;
   }
   return 0;
 }

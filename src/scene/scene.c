@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "scene/geometry.h"
+#include "scene/mesh.h"
 
 /* out = R v */
 void sph_transform_rotate(const sph_transform *T, const double v[3],
@@ -154,6 +155,8 @@ int sph_selection_contains(const sph_scene *s, const sph_selection *sel,
     double tol = (b->lattice == SPH_LATTICE_FACES ? 0.5 : 1.0) * b->spacing;
     return fabs(X[sel->axis] - at) <= tol;
   }
+  case SPH_SELECT_NEAR:
+    return sph_mesh_distance(sel->near, X) <= sel->tolerance;
   }
   return 0;
 }

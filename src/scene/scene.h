@@ -26,8 +26,15 @@ typedef enum sph_shape_kind {
                          along axis with length */
   SPH_SHAPE_DISC,     /* 2D: center, radius */
   SPH_SHAPE_SPHERE,   /* 3D: center, radius */
-  SPH_SHAPE_SHELL     /* 3D spherical shell: center, inner/outer radius */
+  SPH_SHAPE_SHELL,    /* 3D spherical shell: center, inner/outer radius */
+  SPH_SHAPE_MESH,     /* 3D: a closed triangle surface read from a file
+                         (scene/mesh.h); min, max its bounding box */
+  SPH_SHAPE_POLYGON   /* 2D: an outline with holes (scene/polygon.h); min,
+                         max its bounding box */
 } sph_shape_kind;
+
+struct sph_mesh;    /* see mesh.h */
+struct sph_polygon; /* see polygon.h */
 
 typedef struct sph_shape {
   sph_shape_kind kind;
@@ -35,6 +42,9 @@ typedef struct sph_shape {
   double center[3];
   double axis[3]; /* unit vector (cylinder, tube) */
   double radius, inner_radius, outer_radius, length;
+  struct sph_mesh *mesh;       /* owned by the scene */
+  struct sph_polygon *polygon; /* owned by the scene */
+  char file[256];              /* the mesh file as the scene names it */
 } sph_shape;
 
 typedef enum sph_lattice {
@@ -99,8 +109,10 @@ typedef enum sph_select_kind {
   SPH_SELECT_PLANE, /* |X . normal - at| <= tolerance (world frame) */
   SPH_SELECT_BOX,   /* min <= X <= max (inclusive, with tolerance; in the
                        frame of `body` when it names one) */
-  SPH_SELECT_FACE   /* the side of a body's bounding box in its frame: body,
+  SPH_SELECT_FACE,  /* the side of a body's bounding box in its frame: body,
                        axis, sign */
+  SPH_SELECT_NEAR   /* within `tolerance` of a mesh's triangles (in the frame
+                       of `body` when it names one) */
 } sph_select_kind;
 
 typedef struct sph_selection {
@@ -110,8 +122,9 @@ typedef struct sph_selection {
   double at;
   double tolerance; /* default: half the body spacing */
   double min[3], max[3];
-  int body; /* -1: all bodies */
-  int side; /* -1 or +1 for FACE */
+  int body;              /* -1: all bodies */
+  int side;              /* -1 or +1 for FACE */
+  struct sph_mesh *near; /* NEAR; owned by the scene */
 } sph_selection;
 
 typedef enum sph_condition_kind {

@@ -11,6 +11,8 @@
 #include <sys/stat.h>
 
 #include "scene/expr.h"
+#include "scene/mesh.h"
+#include "scene/polygon.h"
 #include "scene/schema_impl.h"
 #include "solver/stability.h"
 
@@ -306,9 +308,13 @@ void sph_scene_destroy(sph_scene *s) {
     sph_expr_destroy(s->bodies[i].velocity.profile);
     for (int c = 0; c < 3; ++c)
       sph_expr_destroy(s->bodies[i].velocity.expr[c]);
+    sph_mesh_destroy(s->bodies[i].shape.mesh);
+    sph_polygon_destroy(s->bodies[i].shape.polygon);
   }
   free(s->bodies);
   free(s->materials);
+  for (size_t i = 0; i < s->nboundaries; ++i)
+    sph_mesh_destroy(s->boundaries[i].select.near);
   free(s->boundaries);
   free(s->contact.walls);
   free(s->output.probes);

@@ -7,26 +7,253 @@
 #include <string.h>
 
 #include "scene/expr.h"
+#include "scene/mesh.h"
+#include "scene/outline_read.h"
+#include "scene/polygon.h"
 #include "scene/schema_impl.h"
+
+/* a file the scene names: relative to the scene file's folder (to the
+ * working one for --set) */
+void sph_schema_file_path(const sph_node *fn, const char *file, char *path,
+                          size_t size) {
+  const char *slash = fn->file ? strrchr(fn->file, '/') : NULL;
+  if (file[0] != '/' && slash && fn->file[0] != '<')
+    snprintf(path, size, "%.*s/%s", (int)(slash - fn->file), fn->file, file);
+  else
+    snprintf(path, size, "%s", file);
+}
+
+/* the resolved scene (a run's scene_used.yaml) names the file wherever it
+ * is read from: its absolute path replaces fn's value */
+void sph_schema_name_absolute(sph_node *fn, const char *path) {
+  char *abs = realpath(path, NULL);
+  if (abs) {
+    free(fn->value);
+    fn->value = abs;
+  }
+}
+
+const char *const sph_length_units[] = {"m",  "cm", "mm", "um",
+                                        "in", "ft", NULL};
+const double sph_length_scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
+
+/* mesh: {file, units, flip_normals}: the file (relative to the scene's)
+ * read, scaled to metres, checked for an inside and an outward surface */
+static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
+                             sph_error *err) {
+  static const char *const keys[] = {"file", "units", "flip_normals", NULL};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  if (s->dimension != 3)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "a mesh is a 3D shape (this scene is 2D)");
+  const char *file;
+  int flip, u;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  sph_node *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
+  SPH_TRY(sph_node_get_bool(g, "flip_normals", 0, 0, &flip, err));
+  if (!file[0] || strlen(file) >= sizeof sh->file)
+    return sph_node_error(fn, err, SPH_ERR_RANGE,
+                          "give the mesh file's name (under %zu bytes)",
+                          sizeof sh->file);
+  snprintf(sh->file, sizeof sh->file, "%s", file);
+  char path[1024];
+  sph_schema_file_path(fn, file, path, sizeof path);
+  double *tri;
+  size_t n;
+  sph_status st = sph_mesh_read(path, &tri, &n, err);
+  if (st == SPH_OK) {
+    st = sph_mesh_create(&sh->mesh, tri, n, sph_length_scale[u], flip, err);
+    free(tri);
+  }
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(fn, err, st, "mesh %s", msg); /* "path: why" */
+  }
+  sph_schema_name_absolute(fn, path);
+  file = sh->file; /* the name as given (fn->value was it) */
+  const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
+  double box = 1.0;
+  for (int c = 0; c < 3; ++c) {
+    sh->min[c] = in->lo[c];
+    sh->max[c] = in->hi[c];
+    box *= in->hi[c] - in->lo[c];
+  }
+  if (!(fabs(in->volume) > 1e-9 * box))
+    return sph_node_error(fn, err, SPH_ERR_GEOMETRY,
+                          "mesh %s encloses no volume (%zu triangles, %zu "
+                          "open edges): an open sheet has no inside to fill",
+                          file, in->triangles, in->open_edges);
+  if (in->volume < 0.0)
+    return sph_node_error(
+        fn, err, SPH_ERR_GEOMETRY,
+        "mesh %s: its volume is negative (%.4g m^3): the triangles face "
+        "inwards; %s",
+        file, in->volume,
+        flip ? "remove flip_normals: true" : "set flip_normals: true");
+  return SPH_OK;
+}
+
+/* one ring of [x, y] pairs appended to *xy (grown by realloc) */
+static sph_status parse_ring(sph_node *ring, double **xy, size_t *n,
+                             sph_error *err) {
+  if (ring->kind != SPH_NODE_SEQ)
+    return sph_node_error(ring, err, SPH_ERR_TYPE,
+                          "expected a list of points [[x, y], ...]");
+  if (ring->count > 1000000)
+    return sph_node_error(ring, err, SPH_ERR_RANGE,
+                          "%zu points: at most 1e6 a ring", ring->count);
+  double *grown = realloc(*xy, 2 * (*n + ring->count) * sizeof *grown);
+  if (!grown)
+    return sph_error_set(err, SPH_ERR_NOMEM, "polygon");
+  *xy = grown;
+  for (size_t i = 0; i < ring->count; ++i) {
+    sph_node *pt = ring->items[i];
+    if (pt->kind != SPH_NODE_SEQ || pt->count != 2)
+      return sph_node_error(pt, err, SPH_ERR_TYPE, "expected a point [x, y]");
+    for (int c = 0; c < 2; ++c)
+      SPH_TRY(sph_node_as_double(pt->items[c], &grown[2 * *n + c], err));
+    ++*n;
+  }
+  return SPH_OK;
+}
+
+/* polygon: {points: [[x, y], ...], holes: [[[x, y], ...], ...]} */
+static sph_status parse_polygon(sph_scene *s, sph_shape *sh, sph_node *g,
+                                sph_error *err) {
+  static const char *const keys[] = {"points", "holes", NULL};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  if (s->dimension != 2)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "a polygon is a 2D shape (in 3D use a mesh)");
+  sph_node *pts, *holes;
+  SPH_TRY(sph_schema_get_seq(g, "points", 1, &pts, err));
+  SPH_TRY(sph_schema_get_seq(g, "holes", 0, &holes, err));
+  size_t nr = 1 + (holes ? holes->count : 0), n = 0;
+  size_t *start = malloc((nr + 1) * sizeof *start);
+  double *xy = NULL;
+  if (!start)
+    return sph_error_set(err, SPH_ERR_NOMEM, "polygon");
+  start[0] = 0;
+  sph_status st = SPH_OK;
+  for (size_t r = 0; st == SPH_OK && r < nr; ++r) {
+    st = parse_ring(r ? holes->items[r - 1] : pts, &xy, &n, err);
+    start[r + 1] = n;
+  }
+  if (st == SPH_OK &&
+      (st = sph_polygon_create(&sh->polygon, xy, start, nr, err)) != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    st = sph_node_error(g, err, st, "polygon: %s", msg);
+  }
+  free(xy);
+  free(start);
+  if (st == SPH_OK)
+    sph_polygon_bounds(sh->polygon, sh->min, sh->max);
+  return st;
+}
+
+/* points [a, b) of xy in reverse order */
+static void reverse_points(double *xy, size_t a, size_t b) {
+  for (; a + 1 < b; ++a, --b)
+    for (int c = 0; c < 2; ++c) {
+      double t = xy[2 * a + c];
+      xy[2 * a + c] = xy[2 * (b - 1) + c];
+      xy[2 * (b - 1) + c] = t;
+    }
+}
+
+/* the ring of largest area first: the outline, the others its holes */
+static void outline_first(double *xy, size_t *start, size_t nr) {
+  size_t best = 0;
+  double most = -1.0;
+  for (size_t r = 0; r < nr; ++r) {
+    double a = 0.0;
+    for (size_t i = start[r]; i < start[r + 1]; ++i) {
+      size_t j = i + 1 < start[r + 1] ? i + 1 : start[r];
+      a += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
+    }
+    if (fabs(a) > most) {
+      most = fabs(a);
+      best = r;
+    }
+  }
+  /* rings [0, best] turned right by ring best's length: three reversals */
+  size_t len = start[best + 1] - start[best], end = start[best + 1];
+  reverse_points(xy, 0, end);
+  reverse_points(xy, 0, len);
+  reverse_points(xy, len, end);
+  for (size_t r = best; r > 0; --r)
+    start[r] = start[r - 1] + len;
+}
+
+/* outline: {file, units}: a CSV or SVG outline (outline_read.c) */
+static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
+                                sph_error *err) {
+  static const char *const keys[] = {"file", "units", NULL};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  if (s->dimension != 2)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "an outline is a 2D shape (in 3D use a mesh)");
+  const char *file;
+  int u;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  sph_node *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
+  if (!file[0] || strlen(file) >= sizeof sh->file)
+    return sph_node_error(fn, err, SPH_ERR_RANGE,
+                          "give the outline file's name (under %zu bytes)",
+                          sizeof sh->file);
+  snprintf(sh->file, sizeof sh->file, "%s", file);
+  char path[1024];
+  sph_schema_file_path(fn, file, path, sizeof path);
+  double *xy;
+  size_t *start, nr;
+  sph_status st = sph_outline_read(path, &xy, &start, &nr, err);
+  if (st == SPH_OK) {
+    for (size_t i = 0; i < 2 * start[nr]; ++i)
+      xy[i] *= sph_length_scale[u];
+    outline_first(xy, start, nr);
+    st = sph_polygon_create(&sh->polygon, xy, start, nr, err);
+    free(xy);
+    free(start);
+  }
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(fn, err, st, "outline %s", msg);
+  }
+  sph_schema_name_absolute(fn, path);
+  sph_polygon_bounds(sh->polygon, sh->min, sh->max);
+  return SPH_OK;
+}
 
 static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                               sph_error *err) {
-  static const char *const kinds[] = {"box",    "cylinder", "ring", "disc",
-                                      "sphere", "shell",    NULL};
+  static const char *const kinds[] = {"box",     "cylinder", "ring", "disc",
+                                      "sphere",  "shell",    "mesh", "polygon",
+                                      "outline", NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
   SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
   SPH_TRY(sph_schema_one_of(n, kinds, "shape", &which, err));
-  static const sph_shape_kind map[] = {SPH_SHAPE_BOX,    SPH_SHAPE_CYLINDER,
-                                       SPH_SHAPE_RING,   SPH_SHAPE_DISC,
-                                       SPH_SHAPE_SPHERE, SPH_SHAPE_SHELL};
+  static const sph_shape_kind map[] = {
+      SPH_SHAPE_BOX,  SPH_SHAPE_CYLINDER, SPH_SHAPE_RING,
+      SPH_SHAPE_DISC, SPH_SHAPE_SPHERE,   SPH_SHAPE_SHELL,
+      SPH_SHAPE_MESH, SPH_SHAPE_POLYGON,  SPH_SHAPE_POLYGON};
   memset(sh, 0, sizeof *sh);
   sh->kind = map[which];
   sph_node *g;
   SPH_TRY(sph_node_get_map(n, kinds[which], 1, &g, err));
   int d = s->dimension;
   switch (sh->kind) {
+  case SPH_SHAPE_MESH:
+    return parse_mesh(s, sh, g, err);
+  case SPH_SHAPE_POLYGON:
+    return which == 8 ? parse_outline(s, sh, g, err)
+                      : parse_polygon(s, sh, g, err);
   case SPH_SHAPE_BOX: {
     static const char *const keys[] = {"min", "max", NULL};
     SPH_TRY(sph_node_check_keys(g, keys, err));
@@ -106,11 +333,11 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   int is3d = sh->kind == SPH_SHAPE_SPHERE || sh->kind == SPH_SHAPE_SHELL ||
              sh->kind == SPH_SHAPE_CYLINDER;
   if ((d == 2 && is3d) || (d == 3 && sh->kind == SPH_SHAPE_DISC))
-    return sph_node_error(sph_node_child(n, kinds[which]), err,
-                          SPH_ERR_GEOMETRY,
-                          "a %s does not exist in %dD (2D: box, disc, ring; "
-                          "3D: box, cylinder, ring, sphere, shell)",
-                          kinds[which], d);
+    return sph_node_error(
+        sph_node_child(n, kinds[which]), err, SPH_ERR_GEOMETRY,
+        "a %s does not exist in %dD (2D: box, disc, ring, polygon; "
+        "3D: box, cylinder, ring, sphere, shell, mesh)",
+        kinds[which], d);
   return SPH_OK;
 }
 
@@ -125,10 +352,10 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
   SPH_TRY(sph_schema_one_of(n, how, "of count or spacing", &which, err));
   int d = s->dimension;
   if (which == 0) {
-    if (b->shape.kind != SPH_SHAPE_BOX)
+    if (b->shape.kind != SPH_SHAPE_BOX && b->shape.kind != SPH_SHAPE_MESH)
       return sph_node_error(sph_node_child(n, "count"), err, SPH_ERR_ARG,
-                            "particle counts apply to boxes; give a spacing "
-                            "for other shapes");
+                            "particle counts apply to boxes and meshes; give "
+                            "a spacing for other shapes");
     double c[3];
     SPH_TRY(sph_node_get_doubles(n, "count", 1, (size_t)d, c, NULL, err));
     b->lattice = SPH_LATTICE_FACES;
@@ -160,6 +387,12 @@ static sph_status parse_particles(sph_scene *s, sph_body *b, sph_node *n,
                           "'%s'",
                           dist);
   b->distribution = (sph_distribution)dk;
+  if (dk == SPH_DIST_RELAX &&
+      (b->shape.kind == SPH_SHAPE_MESH || b->shape.kind == SPH_SHAPE_POLYGON))
+    return sph_node_error(sph_node_child(n, "distribution"), err, SPH_ERR_ARG,
+                          "a %s body is not relaxed yet: use lattice or "
+                          "jitter",
+                          b->shape.kind == SPH_SHAPE_MESH ? "mesh" : "polygon");
   if (dk != SPH_DIST_LATTICE) {
     SPH_TRY(sph_node_get_double(n, "jitter", 0, 0.25, &b->jitter, err));
     if (!(b->jitter >= 0.0 && b->jitter < 0.5))

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/mesh.h"
 #include "scene/schema_impl.h"
 
 /* The placement of the body a selection names, or NULL (world frame). */
@@ -16,9 +17,39 @@ const sph_transform *sph_schema_selection_frame(const sph_scene *s,
   return &s->bodies[sel->body].transform;
 }
 
+/* near: {file, units, distance, body}: the surface a selection is near,
+ * any triangles (an open face is fine); distance read by the caller */
+static sph_status parse_near(sph_scene *s, sph_selection *sel, sph_node *g,
+                             sph_error *err) {
+  if (s->dimension != 3)
+    return sph_node_error(g, err, SPH_ERR_GEOMETRY,
+                          "a near selection takes a mesh: 3D scenes only");
+  const char *file;
+  int u;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  sph_node *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
+  char path[1024];
+  sph_schema_file_path(fn, file, path, sizeof path);
+  double *tri;
+  size_t n;
+  sph_status st = sph_mesh_read(path, &tri, &n, err);
+  if (st == SPH_OK) {
+    st = sph_mesh_create(&sel->near, tri, n, sph_length_scale[u], 0, err);
+    free(tri);
+  }
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(fn, err, st, "mesh %s", msg);
+  }
+  sph_schema_name_absolute(fn, path);
+  return SPH_OK;
+}
+
 static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
                                   sph_error *err) {
-  static const char *const kinds[] = {"plane", "box", "face", NULL};
+  static const char *const kinds[] = {"plane", "box", "face", "near", NULL};
   SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
   SPH_TRY(sph_schema_one_of(n, kinds, "selection", &which, err));
@@ -41,6 +72,15 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
                             s->dimension == 3 ? ", z-, z+" : "", side);
     sel->axis = a;
     sel->side = side[1] == '+' ? 1 : -1;
+  } else if (which == SPH_SELECT_NEAR) {
+    static const char *const keys[] = {"file", "units", "distance", "body",
+                                       NULL};
+    SPH_TRY(sph_node_check_keys(g, keys, err));
+    SPH_TRY(sph_node_get_string(g, "body", 0, NULL, &body, err));
+    SPH_TRY(parse_near(s, sel, g, err));
+    sel->tolerance = -1.0; /* resolved below */
+    if (sph_node_child(g, "distance"))
+      SPH_TRY(sph_node_get_positive(g, "distance", 1, 0, &sel->tolerance, err));
   } else {
     static const char *const pkeys[] = {"axis", "at", "tolerance", "body",
                                         NULL};
@@ -95,13 +135,15 @@ static sph_status parse_selection(sph_scene *s, sph_selection *sel, sph_node *n,
     tol =
         fmin(tol, (bd->lattice == SPH_LATTICE_FACES ? 0.5 : 1.0) * bd->spacing);
   }
-  if (sel->kind == SPH_SELECT_PLANE && sel->tolerance < 0.0) {
+  int own = sel->kind == SPH_SELECT_PLANE || sel->kind == SPH_SELECT_NEAR;
+  if (own && sel->tolerance < 0.0) {
     char buf[40];
     snprintf(buf, sizeof buf, "%.17g", tol);
     sel->tolerance = tol;
-    SPH_TRY(
-        sph_node_insert_default(g, "tolerance", buf, &(sph_node *){0}, err));
-  } else if (sel->kind != SPH_SELECT_PLANE) {
+    SPH_TRY(sph_node_insert_default(
+        g, sel->kind == SPH_SELECT_NEAR ? "distance" : "tolerance", buf,
+        &(sph_node *){0}, err));
+  } else if (!own) {
     sel->tolerance = 1e-9 * spacing;
   }
   return SPH_OK;

@@ -29,6 +29,18 @@ sph_status sph_schema_one_of(sph_node *map, const char *const *choices,
 /* src into a name of SPH_NAME_MAX bytes. */
 void sph_schema_copy_name(char *dst, const char *src);
 
+/* A file the scene names (fn: its node): relative to the scene file's
+ * folder, to the working one when --set gave it; into path[size]. */
+void sph_schema_file_path(const sph_node *fn, const char *file, char *path,
+                          size_t size);
+/* fn's value made the absolute path of the file read (the resolved scene
+ * names it wherever it is read from). */
+void sph_schema_name_absolute(sph_node *fn, const char *path);
+/* The `units` of files: m, cm, mm, um, in, ft (NULL-terminated) and their
+ * lengths in metres. */
+extern const char *const sph_length_units[];
+extern const double sph_length_scale[];
+
 /* The placement of the body a selection names, or NULL (world frame). */
 const sph_transform *sph_schema_selection_frame(const sph_scene *s,
                                                 const sph_selection *sel);

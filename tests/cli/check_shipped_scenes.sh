@@ -11,7 +11,11 @@ trap 'rm -rf "$work"' EXIT
 pass=0
 fail=0
 for f in "$src"/scenes/*.yaml; do
-  if ! "$sph" check "$f" >/dev/null 2>"$work/err"; then
+  "$sph" check "$f" >/dev/null 2>"$work/err"
+  rc=$?
+  if [ $rc -ne 0 ] && grep -q "built without libassimp" "$work/err"; then
+    echo "skipped: $(basename "$f") (this build reads no meshes)"
+  elif [ $rc -ne 0 ]; then
     fail=$((fail + 1))
     echo "FAIL: $f: $(cat "$work/err")"
   elif ! "$sph" check "$f" --resolved >"$work/used.yaml" 2>"$work/err" ||

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Fuzzes the scene loader (tests/fuzz/fuzz_scene.c), the VTK reader
-# (fuzz_vtk.c: .pvd, .vtp, .pvtp) and the checkpoint reader
-# (fuzz_checkpoint.c) for SECONDS in all (default 60: half to the scene
-# loader, a quarter to each reader) under AddressSanitizer and UBSan:
+# (fuzz_vtk.c: .pvd, .vtp, .pvtp), the checkpoint reader
+# (fuzz_checkpoint.c) and the mesh reader with the inside test
+# (fuzz_mesh.c) for SECONDS in all (default 60: half to the scene loader,
+# the rest shared equally by the others) under AddressSanitizer and UBSan:
 # builds them with clang into build-fuzz (SPH_FUZZ_BUILD overrides; nothing
 # is installed: clang and libFuzzer come from ./bootstrap.sh --with-fuzz),
 # replays each one's regression inputs (tests/fuzz/regressions/,
-# regressions_vtk/, regressions_checkpoint/), then fuzzes each from its seed
+# regressions_vtk/, regressions_checkpoint/, regressions_mesh/), then fuzzes each from its seed
 # corpus (the scene loader: every shipped scene, the bad scenes of
 # tests/cli/bad and its regressions; the readers: their regressions and, for
 # the checkpoint, a valid checkpoint the target writes) and the corpus kept
@@ -35,7 +36,7 @@ mkdir -p "$out"
 cmake -S "$src" -B "$build" -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSPH_FUZZ=ON -DSPH_BUILD_TESTS=OFF >"$out/configure.log" 2>&1 ||
   { cat "$out/configure.log" >&2; exit 2; }
-targets=(${SPH_FUZZ_TARGETS:-scene vtk checkpoint})
+targets=(${SPH_FUZZ_TARGETS:-scene vtk checkpoint mesh})
 cmake --build "$build" -j2 --target "${targets[@]/#/fuzz_}" >"$out/build.log" 2>&1 ||
   { tail -40 "$out/build.log" >&2; exit 2; }
 symbolizer=$(command -v llvm-symbolizer || command -v llvm-symbolizer-14 || true)
@@ -78,6 +79,7 @@ fuzz_one() {
     # scenes are a few kB
     extra=(-timeout=30 -max_len=16384 -dict="$src/tests/fuzz/scene.dict") ;;
   vtk) extra=(-timeout=10 -max_len=65536) ;;
+  mesh) extra=(-timeout=10 -max_len=65536) ;;
   checkpoint)
     export SPH_FUZZ_SEED_DIR=$seeds
     extra=(-timeout=10 -max_len=16384) ;;

@@ -168,6 +168,8 @@ static double offset_measure(const sph_shape *s, int dim, double grow) {
   case SPH_SHAPE_CYLINDER:
     return M_PI * R * R * L;
   case SPH_SHAPE_BOX:
+  case SPH_SHAPE_MESH: /* test_mesh.c */
+  case SPH_SHAPE_POLYGON:
     break;
   }
   return NAN;
