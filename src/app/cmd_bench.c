@@ -285,17 +285,22 @@ static void bench_catch_signals(void (*handler)(int)) {
 
 static void remove_dir_files(const char *dir);
 
+int sph_bench_interrupted(void) { return bench_signal != 0; }
+
 static void bench_end_on_signal(const char *dir) {
   int signo = bench_signal;
   if (!signo)
     return;
-  remove_dir_files(dir);
+  if (dir)
+    remove_dir_files(dir);
+  fflush(stdout); /* the rows printed so far */
   signal(signo, SIG_DFL);
   raise(signo);
 }
 
-static int in_child(void (*work)(const void *ctx, void *out), const void *ctx,
-                    void *out, size_t size, int *status, struct rusage *ru) {
+int sph_bench_in_child(void (*work)(const void *ctx, void *out),
+                       const void *ctx, void *out, size_t size, int *status,
+                       struct rusage *ru) {
   int fd[2];
   fflush(NULL);
   if (bench_signal || pipe(fd) != 0)
@@ -348,7 +353,7 @@ static int bench_run(const bench_case *c, int threads, const char *dir,
   case_job job = {c, threads, dir};
   int status = 0;
   struct rusage ru;
-  int got = in_child(case_work, &job, r, sizeof *r, &status, &ru);
+  int got = sph_bench_in_child(case_work, &job, r, sizeof *r, &status, &ru);
   if (got < 0)
     return -1;
   if (!got) {
@@ -379,7 +384,8 @@ static double machine_rate(int threads, int arithmetic) {
   double rate = 0.0;
   int status = 0;
   struct rusage ru;
-  return in_child(machine_work, &job, &rate, sizeof rate, &status, &ru) == 1
+  return sph_bench_in_child(machine_work, &job, &rate, sizeof rate, &status,
+                            &ru) == 1
              ? rate
              : 0.0;
 }
@@ -573,7 +579,7 @@ static void remove_dir_files(const char *dir) {
 }
 
 typedef struct bench_args {
-  int quick, threads, mpi;
+  int quick, threads, mpi, peer;
   const char *json;
   const char *only; /* run only the cases whose name contains it */
 } bench_args;
@@ -600,6 +606,17 @@ static int bench_option(void *ctx, int id, const char *val) {
   }
 }
 
+/* the one operand: `peer`, the peer's own case (src/app/bench_peer.c) */
+static int bench_operand(void *ctx, const char *val) {
+  bench_args *b = ctx;
+  if (strcmp(val, "peer")) {
+    fprintf(stderr, "sph bench: the only operand is 'peer', not '%s'\n", val);
+    return SPH_EXIT_USAGE;
+  }
+  b->peer = 1;
+  return SPH_EXIT_OK;
+}
+
 static const int bench_allowed[] = {
     SPH_OPT_QUICK, SPH_OPT_JSON, SPH_OPT_THREADS, SPH_OPT_CASE, SPH_OPT_MPI, 0};
 static const sph_app_command bench_command = {
@@ -607,12 +624,16 @@ static const sph_app_command bench_command = {
     "usage: sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
     "       [mpirun -np N] sph bench --mpi [--quick] [--json FILE] "
     "[--threads N]\n"
+    "       sph bench peer [--threads N] [--case METHOD] [--json FILE]\n"
     "  throughput, split and memory of a fixed suite of the shipped scenes\n"
     "  (--case: only the case named TEXT, else those whose name contains\n"
     "  it); --mpi: the tl-csph column at 202,771 particles over the ranks\n"
     "  the launcher started (one without), N threads a rank (default 1);\n"
-    "  --mpi --case weak: 101,866 particles a rank\n",
-    bench_allowed, bench_option, NULL};
+    "  --mpi --case weak: 101,866 particles a rank; peer: the twisting\n"
+    "  column at 11x61x11 to 0.5 s (SPHinXsys' case), every method at its\n"
+    "  defaults (--case: those whose name contains METHOD), one thread\n"
+    "  unless --threads N: steps and wall time\n",
+    bench_allowed, bench_option, bench_operand};
 
 /* the suite, or with --case the case of that name, else the cases whose
  * name contains the text (none: a message); NULL without memory */
@@ -636,7 +657,7 @@ static bench_case *select_cases(int quick, const char *only, int *ncases) {
 }
 
 int sph_cmd_bench(int argc, char **argv) {
-  bench_args b = {0, 0, 0, NULL, NULL};
+  bench_args b = {0, 0, 0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
@@ -648,6 +669,16 @@ int sph_cmd_bench(int argc, char **argv) {
               "default) or weak, not '%s'\n",
               b.only);
     return SPH_EXIT_USAGE;
+  }
+  if (b.peer && (b.mpi || b.quick)) {
+    fprintf(stderr, "sph bench: peer takes neither --mpi nor --quick\n");
+    return SPH_EXIT_USAGE;
+  }
+  if (b.peer && sph_domain_world_size() == 1) {
+    bench_catch_signals(on_bench_signal);
+    rc = sph_bench_peer(b.threads ? b.threads : 1, b.only, b.json);
+    bench_end_on_signal(NULL);
+    return rc;
   }
   if (b.mpi)
     return sph_bench_mpi(b.quick, weak, b.threads ? b.threads : 1, b.json);

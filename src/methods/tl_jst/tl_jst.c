@@ -231,7 +231,12 @@ static sph_status tl_jst_constrain(void *ctx, double t, sph_error *err) {
 
 static double tl_jst_stable_dt(sph_sim *sim) {
   tl_jst *m = sim->method_data;
-  return sph_ref_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
+  if (!m->current_wave_speed || m->wave_speed_every == 1)
+    return sph_ref_stable_dt(&m->ref, sim, m->cfl, m->current_wave_speed);
+  /* the current state's c_p at every wave_speed_every-th step, held between */
+  if (m->c_held <= 0.0 || sim->steps % (unsigned long)m->wave_speed_every == 0)
+    m->c_held = m->cfl * sim->dp / sph_ref_stable_dt(&m->ref, sim, m->cfl, 1);
+  return m->cfl * sim->dp / m->c_held;
 }
 
 static sph_status tl_jst_step(sph_sim *sim, double dt, sph_error *err) {
@@ -297,7 +302,7 @@ typedef struct tl_jst_options {
   sph_rk_step integrate;
   int lagrange;          /* essential_bc: lagrange (else direct) */
   int lagrange_momentum; /* the total momentum rows of the projection */
-  int current_wave_speed;
+  int current_wave_speed, wave_speed_every;
   double cfl;
   int amp, jproj; /* angular momentum and JST projections */
   double e2p, e4p, e2j, e4j;
@@ -344,6 +349,7 @@ static sph_status tl_jst_options_parse(sph_node *opt, tl_jst_options *o,
                                      "cfl",
                                      "essential_bc",
                                      "wave_speed",
+                                     "wave_speed_every",
                                      "lagrange_momentum",
                                      NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
@@ -370,6 +376,13 @@ static sph_status tl_jst_options_parse(sph_node *opt, tl_jst_options *o,
   int ws;
   SPH_TRY(sph_node_get_choice(opt, "wave_speed", speeds, "current", &ws, err));
   o->current_wave_speed = ws == 0;
+  long every;
+  SPH_TRY(sph_node_get_int(opt, "wave_speed_every", 0, 1, &every, err));
+  if (every < 1 || every > 1000000)
+    return sph_node_error(
+        sph_node_child(opt, "wave_speed_every"), err, SPH_ERR_RANGE,
+        "wave_speed_every must be in [1, 1000000], got %ld", every);
+  o->wave_speed_every = (int)every;
   o->integrate = integ == 1 ? sph_ssp_rk3_step : sph_tvd_rk2_step;
   o->fields = (tl_jst_fields)f;
   o->force = (tl_jst_force)fo;
@@ -503,6 +516,7 @@ static sph_status tl_jst_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->sim = sim;
   size_t n = sim->ps->n;
   m->current_wave_speed = o.current_wave_speed;
+  m->wave_speed_every = o.wave_speed_every;
   m->integrate = o.integrate;
   m->fields = o.fields;
   m->force = o.force;
