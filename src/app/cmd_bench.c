@@ -656,6 +656,19 @@ static bench_case *select_cases(int quick, const char *only, int *ncases) {
   return cases;
 }
 
+/* sph bench peer (src/app/bench_peer.c), in one process (no mpirun) */
+static int bench_peer(const bench_args *b) {
+  if (b->mpi || b->quick || sph_domain_world_size() > 1) {
+    fprintf(stderr, "sph bench: peer takes neither --mpi nor --quick, and "
+                    "runs without mpirun\n");
+    return SPH_EXIT_USAGE;
+  }
+  bench_catch_signals(on_bench_signal);
+  int rc = sph_bench_peer(b->threads ? b->threads : 1, b->only, b->json);
+  bench_end_on_signal(NULL);
+  return rc;
+}
+
 int sph_cmd_bench(int argc, char **argv) {
   bench_args b = {0, 0, 0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
@@ -670,16 +683,8 @@ int sph_cmd_bench(int argc, char **argv) {
               b.only);
     return SPH_EXIT_USAGE;
   }
-  if (b.peer && (b.mpi || b.quick)) {
-    fprintf(stderr, "sph bench: peer takes neither --mpi nor --quick\n");
-    return SPH_EXIT_USAGE;
-  }
-  if (b.peer && sph_domain_world_size() == 1) {
-    bench_catch_signals(on_bench_signal);
-    rc = sph_bench_peer(b.threads ? b.threads : 1, b.only, b.json);
-    bench_end_on_signal(NULL);
-    return rc;
-  }
+  if (b.peer)
+    return bench_peer(&b);
   if (b.mpi)
     return sph_bench_mpi(b.quick, weak, b.threads ? b.threads : 1, b.json);
   if (sph_domain_world_size() > 1) { /* forks a process per case */
