@@ -53,6 +53,13 @@ int sph_bench_in_child(void (*work)(const void *ctx, void *out),
 /* a signal asked the suite to stop */
 int sph_bench_interrupted(void);
 
+/* the CPU model of /proc/cpuinfo, else "unknown" */
+void sph_bench_cpu_model(char *out, size_t len);
+
+/* Karp and Flatt's serial fraction from the wall time of a step on one
+ * thread and on p (NaN when p < 2 or a time is not positive) */
+double sph_bench_serial_fraction(double step1, double stepp, int p);
+
 /* sph bench peer: the twisting column at 11x61x11 to 0.5 s for every method
  * (those whose name contains `only`) at its defaults, on `threads` threads */
 int sph_bench_peer(int threads, const char *only, const char *json);

@@ -396,6 +396,14 @@ static double per_thread_rate(const bench_result *r) {
                                : 0.0;
 }
 
+/* the serial fraction of the step from a case's 1- and N-thread rows */
+static double case_serial_fraction(const bench_result *one,
+                                   const bench_result *r) {
+  return sph_bench_serial_fraction(one->step_seconds / (double)one->steps,
+                                   r->step_seconds / (double)r->steps,
+                                   r->threads);
+}
+
 static void print_row(const bench_case *c, const bench_result *r,
                       long baseline_kb) {
   if (!r->ok) {
@@ -459,30 +467,13 @@ void sph_bench_json_str(FILE *f, const char *s) {
   fputc('"', f);
 }
 
-static void cpu_model(char *out, size_t len) {
-  snprintf(out, len, "unknown");
-  FILE *f = fopen("/proc/cpuinfo", "r");
-  char line[512];
-  while (f && fgets(line, sizeof line, f))
-    if (!strncmp(line, "model name", 10)) {
-      const char *v = strchr(line, ':');
-      if (v) {
-        v += 1 + strspn(v + 1, " \t");
-        snprintf(out, len, "%.*s", (int)strcspn(v, "\n"), v);
-      }
-      break;
-    }
-  if (f)
-    fclose(f);
-}
-
 /* the JSON's opening: schema, suite and machine */
 /* the head and the machine; speed[0][t]: the memory bandwidth, speed[1][t]
  * the arithmetic rate on the bench's nthr thread counts (none: nthr 0) */
 void sph_bench_json_head(FILE *f, const char *suite, long cores,
                          const double speed[2][2], int nthr) {
   char cpu[256];
-  cpu_model(cpu, sizeof cpu);
+  sph_bench_cpu_model(cpu, sizeof cpu);
   fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
           BENCH_SCHEMA, suite);
   fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
@@ -546,6 +537,9 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
       if (cases[c].frame)
         fprintf(f, ", \"vtp_seconds\": %.6g, \"frame_seconds\": %.6g",
                 r->vtp_seconds, r->frame_seconds);
+      if (t == 1 && res[c * nthr].ok)
+        fprintf(f, ", \"serial_fraction\": %.6g",
+                case_serial_fraction(&res[c * nthr], r));
       fprintf(f, ", \"parts\": {");
       for (int i = 0; i < r->nparts; ++i) {
         fprintf(f, "%s", i ? ", " : "");
@@ -772,6 +766,9 @@ int sph_cmd_bench(int argc, char **argv) {
       bench_end_on_signal(dir);
       failed |= !r->ok;
       print_row(&cases[c], r, baseline_kb);
+      if (t == 1 && r->ok && res[c * nthr].ok)
+        printf("      serial fraction %.3f (Karp-Flatt: 1 and %d threads)\n",
+               case_serial_fraction(&res[c * nthr], r), r->threads);
     }
   rc = failed ? SPH_EXIT_FAIL : SPH_EXIT_OK;
   if (json && write_json(json, cases, ncases, res, nthr, quick, cores,

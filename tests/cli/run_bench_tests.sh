@@ -36,6 +36,8 @@ for c in cases:
             and c[k] > 0, (c["name"], k, c[k])
     assert c["parts"] and all(math.isfinite(v) and v >= 0
                               for v in c["parts"].values()), c
+    # the N-thread row's serial fraction (Karp-Flatt; noisy, may be < 0)
+    assert c["threads"] == 1 or math.isfinite(c["serial_fraction"]), c
     if "vtp_seconds" in c:
         assert c["vtp_seconds"] > 0 and c["frame_seconds"] > 0, c
 assert any("vtp_seconds" in c for c in cases)
