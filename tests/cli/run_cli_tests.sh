@@ -86,6 +86,12 @@ d3=$(dt_of "{name: tl-jst, integrator: ssp-rk3}")
 d3e=$(dt_of "{name: tl-jst, integrator: ssp-rk3, cfl: 0.3}")
 python3 -c "import sys; a,b,c=map(float,sys.argv[1:]); assert abs(b/a-4)<1e-3 and c==a" \
   "$d2" "$d3" "$d3e" 2>/dev/null && ok || bad "tl-jst default cfl: dt $d2 / $d3 / $d3e"
+# wave_speed_every holds the current wave speed K steps: the first step is
+# the same; 0 is refused naming the key
+[ "$(dt_of "{name: tl-jst, wave_speed_every: 10}")" = "$d2" ] && ok || bad "wave_speed_every 10: first dt"
+"$sph" check "$src/scenes/twisting_column.yaml" --set method.wave_speed_every=0 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "method.wave_speed_every: wave_speed_every must be in" "$work/stderr" && ok ||
+  bad "wave_speed_every 0: $(cat "$work/stderr")"
 "$sph" frobnicate 2>/dev/null
 [ $? -eq 2 ] && ok || bad "unknown command"
 "$sph" run --threads 0 2>/dev/null
