@@ -43,4 +43,25 @@ sph_status sph_bench_steps(sph_run *run, unsigned long steps, sph_error *err);
  * column as tall as the ranks); rank 0 prints and writes the JSON */
 int sph_bench_mpi(int quick, int weak, int threads, const char *json);
 
+/* runs work(ctx, out) in a child process and reads its size bytes of out
+ * back: 1 when they all came, 0 when not (status: how the child ended), -1
+ * when no child could be started */
+struct rusage;
+int sph_bench_in_child(void (*work)(const void *ctx, void *out),
+                       const void *ctx, void *out, size_t size, int *status,
+                       struct rusage *ru);
+/* a signal asked the suite to stop */
+int sph_bench_interrupted(void);
+
+/* the CPU model of /proc/cpuinfo, else "unknown" */
+void sph_bench_cpu_model(char *out, size_t len);
+
+/* Karp and Flatt's serial fraction from the wall time of a step on one
+ * thread and on p (NaN when p < 2 or a time is not positive) */
+double sph_bench_serial_fraction(double step1, double stepp, int p);
+
+/* sph bench peer: the twisting column at 11x61x11 to 0.5 s for every method
+ * (those whose name contains `only`) at its defaults, on `threads` threads */
+int sph_bench_peer(int threads, const char *only, const char *json);
+
 #endif

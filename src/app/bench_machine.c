@@ -7,11 +7,26 @@
  *   hardware threads share its arithmetic units: the figure shows it.
  * Each is the best of the repetitions of 0.3 s (at least ten) on a given
  * thread count; bench runs them in a child process, as the cases
- * (cmd_bench.c). */
+ * (cmd_bench.c).
+ * - A case's serial fraction: Karp and Flatt's experimentally determined
+ *   fraction e = (1/S - 1/p) / (1 - 1/p) of Amdahl's law, S the speed-up of
+ *   its step on p threads over one.
+ * - The CPU model (the JSON's machine). */
+#include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "app/app_impl.h"
+#include "app/bench_impl.h"
+
+double sph_bench_serial_fraction(double step1, double stepp, int p) {
+  if (!(step1 > 0.0 && stepp > 0.0) || p < 2)
+    return NAN;
+  double speedup = step1 / stepp;
+  return (1.0 / speedup - 1.0 / p) / (1.0 - 1.0 / p);
+}
 
 double bench_machine_triad(int threads, size_t bytes) {
   long n = (long)(bytes / sizeof(double));
@@ -77,4 +92,22 @@ double bench_machine_flops(int threads) {
   }
   /* the sums are read, so the chains cannot be dropped */
   return sink > 0.0 ? best : 0.0;
+}
+
+/* the CPU model of /proc/cpuinfo, else "unknown" */
+void sph_bench_cpu_model(char *out, size_t len) {
+  snprintf(out, len, "unknown");
+  FILE *f = fopen("/proc/cpuinfo", "r");
+  char line[512];
+  while (f && fgets(line, sizeof line, f))
+    if (!strncmp(line, "model name", 10)) {
+      const char *v = strchr(line, ':');
+      if (v) {
+        v += 1 + strspn(v + 1, " \t");
+        snprintf(out, len, "%.*s", (int)strcspn(v, "\n"), v);
+      }
+      break;
+    }
+  if (f)
+    fclose(f);
 }

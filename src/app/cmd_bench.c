@@ -285,17 +285,22 @@ static void bench_catch_signals(void (*handler)(int)) {
 
 static void remove_dir_files(const char *dir);
 
+int sph_bench_interrupted(void) { return bench_signal != 0; }
+
 static void bench_end_on_signal(const char *dir) {
   int signo = bench_signal;
   if (!signo)
     return;
-  remove_dir_files(dir);
+  if (dir)
+    remove_dir_files(dir);
+  fflush(stdout); /* the rows printed so far */
   signal(signo, SIG_DFL);
   raise(signo);
 }
 
-static int in_child(void (*work)(const void *ctx, void *out), const void *ctx,
-                    void *out, size_t size, int *status, struct rusage *ru) {
+int sph_bench_in_child(void (*work)(const void *ctx, void *out),
+                       const void *ctx, void *out, size_t size, int *status,
+                       struct rusage *ru) {
   int fd[2];
   fflush(NULL);
   if (bench_signal || pipe(fd) != 0)
@@ -348,7 +353,7 @@ static int bench_run(const bench_case *c, int threads, const char *dir,
   case_job job = {c, threads, dir};
   int status = 0;
   struct rusage ru;
-  int got = in_child(case_work, &job, r, sizeof *r, &status, &ru);
+  int got = sph_bench_in_child(case_work, &job, r, sizeof *r, &status, &ru);
   if (got < 0)
     return -1;
   if (!got) {
@@ -379,7 +384,8 @@ static double machine_rate(int threads, int arithmetic) {
   double rate = 0.0;
   int status = 0;
   struct rusage ru;
-  return in_child(machine_work, &job, &rate, sizeof rate, &status, &ru) == 1
+  return sph_bench_in_child(machine_work, &job, &rate, sizeof rate, &status,
+                            &ru) == 1
              ? rate
              : 0.0;
 }
@@ -388,6 +394,14 @@ static double per_thread_rate(const bench_result *r) {
   return r->step_seconds > 0.0 ? (double)r->particles * (double)r->steps /
                                      r->step_seconds / r->threads
                                : 0.0;
+}
+
+/* the serial fraction of the step from a case's 1- and N-thread rows */
+static double case_serial_fraction(const bench_result *one,
+                                   const bench_result *r) {
+  return sph_bench_serial_fraction(one->step_seconds / (double)one->steps,
+                                   r->step_seconds / (double)r->steps,
+                                   r->threads);
 }
 
 static void print_row(const bench_case *c, const bench_result *r,
@@ -453,30 +467,13 @@ void sph_bench_json_str(FILE *f, const char *s) {
   fputc('"', f);
 }
 
-static void cpu_model(char *out, size_t len) {
-  snprintf(out, len, "unknown");
-  FILE *f = fopen("/proc/cpuinfo", "r");
-  char line[512];
-  while (f && fgets(line, sizeof line, f))
-    if (!strncmp(line, "model name", 10)) {
-      const char *v = strchr(line, ':');
-      if (v) {
-        v += 1 + strspn(v + 1, " \t");
-        snprintf(out, len, "%.*s", (int)strcspn(v, "\n"), v);
-      }
-      break;
-    }
-  if (f)
-    fclose(f);
-}
-
 /* the JSON's opening: schema, suite and machine */
 /* the head and the machine; speed[0][t]: the memory bandwidth, speed[1][t]
  * the arithmetic rate on the bench's nthr thread counts (none: nthr 0) */
 void sph_bench_json_head(FILE *f, const char *suite, long cores,
                          const double speed[2][2], int nthr) {
   char cpu[256];
-  cpu_model(cpu, sizeof cpu);
+  sph_bench_cpu_model(cpu, sizeof cpu);
   fprintf(f, "{\n  \"schema_version\": %d,\n  \"suite\": \"%s\",\n",
           BENCH_SCHEMA, suite);
   fprintf(f, "  \"machine\": {\"cores\": %ld, \"cpu\": ", cores);
@@ -540,6 +537,9 @@ static int write_json(const char *path, const bench_case *cases, int ncases,
       if (cases[c].frame)
         fprintf(f, ", \"vtp_seconds\": %.6g, \"frame_seconds\": %.6g",
                 r->vtp_seconds, r->frame_seconds);
+      if (t == 1 && res[c * nthr].ok)
+        fprintf(f, ", \"serial_fraction\": %.6g",
+                case_serial_fraction(&res[c * nthr], r));
       fprintf(f, ", \"parts\": {");
       for (int i = 0; i < r->nparts; ++i) {
         fprintf(f, "%s", i ? ", " : "");
@@ -573,7 +573,7 @@ static void remove_dir_files(const char *dir) {
 }
 
 typedef struct bench_args {
-  int quick, threads, mpi;
+  int quick, threads, mpi, peer;
   const char *json;
   const char *only; /* run only the cases whose name contains it */
 } bench_args;
@@ -600,6 +600,17 @@ static int bench_option(void *ctx, int id, const char *val) {
   }
 }
 
+/* the one operand: `peer`, the peer's own case (src/app/bench_peer.c) */
+static int bench_operand(void *ctx, const char *val) {
+  bench_args *b = ctx;
+  if (strcmp(val, "peer")) {
+    fprintf(stderr, "sph bench: the only operand is 'peer', not '%s'\n", val);
+    return SPH_EXIT_USAGE;
+  }
+  b->peer = 1;
+  return SPH_EXIT_OK;
+}
+
 static const int bench_allowed[] = {
     SPH_OPT_QUICK, SPH_OPT_JSON, SPH_OPT_THREADS, SPH_OPT_CASE, SPH_OPT_MPI, 0};
 static const sph_app_command bench_command = {
@@ -607,12 +618,16 @@ static const sph_app_command bench_command = {
     "usage: sph bench [--quick] [--json FILE] [--threads N] [--case TEXT]\n"
     "       [mpirun -np N] sph bench --mpi [--quick] [--json FILE] "
     "[--threads N]\n"
+    "       sph bench peer [--threads N] [--case METHOD] [--json FILE]\n"
     "  throughput, split and memory of a fixed suite of the shipped scenes\n"
     "  (--case: only the case named TEXT, else those whose name contains\n"
     "  it); --mpi: the tl-csph column at 202,771 particles over the ranks\n"
     "  the launcher started (one without), N threads a rank (default 1);\n"
-    "  --mpi --case weak: 101,866 particles a rank\n",
-    bench_allowed, bench_option, NULL};
+    "  --mpi --case weak: 101,866 particles a rank; peer: the twisting\n"
+    "  column at 11x61x11 to 0.5 s (SPHinXsys' case), every method at its\n"
+    "  defaults (--case: those whose name contains METHOD), one thread\n"
+    "  unless --threads N: steps and wall time\n",
+    bench_allowed, bench_option, bench_operand};
 
 /* the suite, or with --case the case of that name, else the cases whose
  * name contains the text (none: a message); NULL without memory */
@@ -635,8 +650,21 @@ static bench_case *select_cases(int quick, const char *only, int *ncases) {
   return cases;
 }
 
+/* sph bench peer (src/app/bench_peer.c), in one process (no mpirun) */
+static int bench_peer(const bench_args *b) {
+  if (b->mpi || b->quick || sph_domain_world_size() > 1) {
+    fprintf(stderr, "sph bench: peer takes neither --mpi nor --quick, and "
+                    "runs without mpirun\n");
+    return SPH_EXIT_USAGE;
+  }
+  bench_catch_signals(on_bench_signal);
+  int rc = sph_bench_peer(b->threads ? b->threads : 1, b->only, b->json);
+  bench_end_on_signal(NULL);
+  return rc;
+}
+
 int sph_cmd_bench(int argc, char **argv) {
-  bench_args b = {0, 0, 0, NULL, NULL};
+  bench_args b = {0, 0, 0, 0, NULL, NULL};
   int rc = sph_app_getopt(&bench_command, argc, argv, &b);
   if (rc != SPH_EXIT_OK)
     return rc == SPH_APP_HELP ? SPH_EXIT_OK : rc;
@@ -649,6 +677,8 @@ int sph_cmd_bench(int argc, char **argv) {
               b.only);
     return SPH_EXIT_USAGE;
   }
+  if (b.peer)
+    return bench_peer(&b);
   if (b.mpi)
     return sph_bench_mpi(b.quick, weak, b.threads ? b.threads : 1, b.json);
   if (sph_domain_world_size() > 1) { /* forks a process per case */
@@ -736,6 +766,9 @@ int sph_cmd_bench(int argc, char **argv) {
       bench_end_on_signal(dir);
       failed |= !r->ok;
       print_row(&cases[c], r, baseline_kb);
+      if (t == 1 && r->ok && res[c * nthr].ok)
+        printf("      serial fraction %.3f (Karp-Flatt: 1 and %d threads)\n",
+               case_serial_fraction(&res[c * nthr], r), r->threads);
     }
   rc = failed ? SPH_EXIT_FAIL : SPH_EXIT_OK;
   if (json && write_json(json, cases, ncases, res, nthr, quick, cores,

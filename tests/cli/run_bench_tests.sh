@@ -36,6 +36,8 @@ for c in cases:
             and c[k] > 0, (c["name"], k, c[k])
     assert c["parts"] and all(math.isfinite(v) and v >= 0
                               for v in c["parts"].values()), c
+    # the N-thread row's serial fraction (Karp-Flatt; noisy, may be < 0)
+    assert c["threads"] == 1 or math.isfinite(c["serial_fraction"]), c
     if "vtp_seconds" in c:
         assert c["vtp_seconds"] > 0 and c["frame_seconds"] > 0, c
 assert any("vtp_seconds" in c for c in cases)
@@ -56,5 +58,17 @@ sleep 1
 ls "$TMPDIR"/sph_bench_* >/dev/null 2>&1 && bad "folder left after SIGINT" || ok
 pgrep -f "$sph bench --quick" >/dev/null &&
   bad "a case still running after SIGINT" || ok
+# sph bench peer (the peer's column for every method, minutes: not run in
+# full here): a wrong operand, --quick, an unknown method exit 2; an
+# interrupt ends it with its header printed and no case left running
+for args in "peers" "peer --quick" "peer --case nosuch"; do
+  "$sph" bench $args >/dev/null 2>&1
+  [ $? -eq 2 ] && ok || bad "sph bench $args: exit not 2"
+done
+timeout -s INT 5 "$sph" bench peer --case tl-jst >"$work/peer" 2>&1
+sleep 1
+grep -q "11x61x11 to t = 0.5 s" "$work/peer" && ok || bad "peer: $(cat "$work/peer")"
+pgrep -f "$sph bench peer" >/dev/null &&
+  bad "a peer case still running after SIGINT" || ok
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

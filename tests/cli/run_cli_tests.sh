@@ -86,6 +86,21 @@ done
 "$sph" check "$src/scenes/spinning_cube.yaml" --set kernel.h_over_dp=0.9 2>"$work/stderr"
 [ $? -eq 2 ] && grep -qF "spinning_cube.yaml:18:5: body cube: singular" "$work/stderr" &&
   grep -qF "at particle 0 (-0.5, -0.5, -0.5)" "$work/stderr" && ok || bad "singular: $(cat "$work/stderr")"
+# tl-jst's default CFL follows the integrator (issue 33): SSP-RK3 1.2, 4x
+# TVD-RK2's 0.3 on the same state; an explicit cfl wins
+dt_of() { "$sph" check "$src/scenes/twisting_column.yaml" --set "method=$1" 2>&1 |
+  sed -n 's/.*first dt \([0-9.e+-]*\) s.*/\1/p'; }
+d2=$(dt_of "{name: tl-jst}")
+d3=$(dt_of "{name: tl-jst, integrator: ssp-rk3}")
+d3e=$(dt_of "{name: tl-jst, integrator: ssp-rk3, cfl: 0.3}")
+python3 -c "import sys; a,b,c=map(float,sys.argv[1:]); assert abs(b/a-4)<1e-3 and c==a" \
+  "$d2" "$d3" "$d3e" 2>/dev/null && ok || bad "tl-jst default cfl: dt $d2 / $d3 / $d3e"
+# wave_speed_every holds the current wave speed K steps: the first step is
+# the same; 0 is refused naming the key
+[ "$(dt_of "{name: tl-jst, wave_speed_every: 10}")" = "$d2" ] && ok || bad "wave_speed_every 10: first dt"
+"$sph" check "$src/scenes/twisting_column.yaml" --set method.wave_speed_every=0 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "method.wave_speed_every: wave_speed_every must be in" "$work/stderr" && ok ||
+  bad "wave_speed_every 0: $(cat "$work/stderr")"
 "$sph" frobnicate 2>/dev/null
 [ $? -eq 2 ] && ok || bad "unknown command"
 "$sph" run --threads 0 2>/dev/null

@@ -232,6 +232,34 @@ START_TEST(energy_is_second_order_without_dissipation) {
 }
 END_TEST
 
+/* wave_speed_every K holds the current wave speed K steps (issue 33): the
+ * step count moves by well under 1 % against K = 1 (the speed changes little
+ * in 10 steps), and the energy with it */
+START_TEST(wave_speed_every_holds_the_speed) {
+  const char *every[2] = {"method.wave_speed_every=1",
+                          "method.wave_speed_every=10"};
+  unsigned long steps[2];
+  double energy[2];
+  for (int i = 0; i < 2; ++i) {
+    sph_scene *s;
+    sph_sim *sim;
+    sph_error err;
+    ck_assert_msg(make(cube, &every[i], 1, &s, &sim, &err) == SPH_OK, "%s",
+                  err.message);
+    run_to_end(sim);
+    double k, w;
+    sim->method->energy(sim, &k, &w);
+    steps[i] = sim->steps;
+    energy[i] = k + w;
+    sph_sim_destroy(sim);
+    sph_scene_destroy(s);
+  }
+  printf("wave_speed_every 1 / 10: %lu / %lu steps\n", steps[0], steps[1]);
+  ck_assert(steps[1] <= steps[0] && steps[1] >= 0.99 * (double)steps[0]);
+  ck_assert(fabs(energy[1] - energy[0]) < 1e-3 * energy[0]);
+}
+END_TEST
+
 START_TEST(variants_agree) {
   const char *variants[3] = {"method.fields=pF", "method.fields=pFJ",
                              "method.fields=pFHJ"};
@@ -586,6 +614,7 @@ int main(void) {
   tcase_add_test(tc, force_matches_brute_force);
   tcase_add_test(tc, energy_is_second_order_without_dissipation);
   tcase_add_test(tc, variants_agree);
+  tcase_add_test(tc, wave_speed_every_holds_the_speed);
   tcase_add_test(tc, terms_follow_the_scene);
   tcase_add_test(tc, option_errors);
   tcase_add_test(tc, cable_against_dalembert);

@@ -20,6 +20,8 @@ typedef struct tl_jst {
   tl_jst_force force;
   double cfl;
   int current_wave_speed; /* dt from the current state's c_p */
+  int wave_speed_every;   /* the current c_p every that many steps */
+  double c_held;          /* the c_p of the last of those steps (0: none) */
   sph_ref ref;            /* neighbours, gradients, materials */
   double *lap;            /* V_b Lap W~_b(X_a) per slot (NULL if unused) */
   double *fgrad;          /* eq. 31: grad W~1_b(X_a) per slot */
