@@ -28,7 +28,7 @@ static void png_fit(const sph_scene *s, const double lo[3], const double hi[3],
       he = (int)((1.0 - PNG_LABEL_SHARE) * H);
   sph_view_fit(lo, hi, c->given ? c->azimuth : 30.0,
                c->given ? c->elevation : 20.0, c->given ? c->zoom : 1.0,
-               c->given ? c->orthographic : 0, s->dimension, we, he, v);
+               c->given ? c->orthographic : 1, s->dimension, we, he, v);
   double f[3], r[3], dist = 0.0;
   for (int k = 0; k < 3; ++k) {
     f[k] = v->target[k] - v->eye[k];
@@ -277,27 +277,31 @@ void sph_png_box(const float *xyz, size_t m, double lo[3], double hi[3]) {
     }
 }
 
-/* Follow camera: refit when a drawn particle leaves the framed box [lo, hi]
- * of the drawn particles, or when the bodies have shrunk to under half of
- * it along every axis (hysteresis: the view holds still while the motion
- * stays inside). Nothing for an empty box. */
+/* Follow camera: the drawn box [lo, hi] joins the union of every frame's
+ * box so far, and the view is the fit of that union padded by half a
+ * spacing and 2 % of each side (no room for motion: the union holds it).
+ * The camera only ever widens, never jumps back; png_store.c draws the
+ * frames again with the fit of the whole run's union. Nothing for an
+ * empty box. */
 void sph_png_follow(png_sink *p, const double box_lo[3],
                     const double box_hi[3]) {
   if (!(box_lo[0] <= box_hi[0]))
     return;
-  double lo[3], hi[3];
-  memcpy(lo, box_lo, sizeof lo);
-  memcpy(hi, box_hi, sizeof hi);
-  int outside = 0, small = 1;
+  int grew = !p->have_box;
   for (int k = 0; k < 3; ++k) {
-    double fit = p->fit_hi[k] - p->fit_lo[k];
-    outside |= lo[k] < p->fit_lo[k] || hi[k] > p->fit_hi[k];
-    if (fit > 4.0 * p->dp)
-      small &= hi[k] - lo[k] < 0.5 * fit;
+    grew |= box_lo[k] < p->box_lo[k] || box_hi[k] > p->box_hi[k];
+    p->box_lo[k] = p->have_box ? fmin(p->box_lo[k], box_lo[k]) : box_lo[k];
+    p->box_hi[k] = p->have_box ? fmax(p->box_hi[k], box_hi[k]) : box_hi[k];
   }
-  if (!outside && !small)
+  p->have_box = 1;
+  if (!grew)
     return;
-  png_pad(p->dp, lo, hi);
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    double pad = 0.5 * p->dp + 0.02 * (p->box_hi[k] - p->box_lo[k]);
+    lo[k] = p->box_lo[k] - pad;
+    hi[k] = p->box_hi[k] + pad;
+  }
   memcpy(p->fit_lo, lo, sizeof lo);
   memcpy(p->fit_hi, hi, sizeof hi);
   png_fit(p->scene, lo, hi, &p->view);

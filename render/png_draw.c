@@ -155,6 +155,16 @@ void sph_png_renderer_destroy(png_sink *p) {
   p->text = NULL;
 }
 
+/* A snapshot recorded in the scratch file, then drawn (unless deferred). */
+sph_status sph_png_emit(png_sink *p, const png_frame *fr, sph_error *err) {
+  sph_status st = sph_png_store_put(p, fr, !p->deferred, err);
+  SPH_TRY(p->domain ? sph_domain_agree(p->domain, st, err) : st);
+  if (p->deferred)
+    return SPH_OK;
+  return p->domain ? sph_png_render_ranks(p, fr, err)
+                   : sph_png_render(p, fr, err);
+}
+
 /* Render thread: creates the renderer, then writes each frame handed over
  * until told to quit; the context is made, used and destroyed here. */
 void *sph_png_thread(void *arg) {

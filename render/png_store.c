@@ -1,0 +1,192 @@
+/* The PNG sink's one colour scale and one camera per run (png_sink.c
+ * describes the sink): every frame's snapshot (the drawn particles'
+ * positions, radius factors and colour values; over MPI ranks their ids
+ * and reference positions too) is appended to a scratch file,
+ * frames/.<scene>.frames[.pR], with the range and camera it was drawn with.
+ * Frames are drawn during the run with the range and camera known so far
+ * (both only ever widen); when the run closes (at its end, or stopped by a
+ * signal or sph_run_close), the run-wide range and camera are final and
+ * every frame drawn with another one is drawn again from its record, so
+ * every frame of the run, and its mp4, shares one colour bar and one view.
+ * The scratch file is removed then (and by destroy after a failure); its
+ * size is the frames' particles times 24 bytes (3 floats, 1 float, 1
+ * double), on disk, never in memory: reading it back uses the sink's own
+ * snapshot buffers. */
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/png_sink_impl.h"
+
+/* What a record holds before its arrays. */
+typedef struct png_record {
+  int32_t index, drawn; /* drawn: 0 for a frame not drawn yet (resume) */
+  double time, lo, hi, vmin, vmax;
+  sph_view view;
+  uint64_t m;
+} png_record;
+
+sph_status sph_png_store_open(png_sink *p, sph_error *err) {
+  if (p->domain)
+    snprintf(p->store_path, sizeof p->store_path, "%s/.%s.frames.p%d", p->dir,
+             p->name, p->rank);
+  else
+    snprintf(p->store_path, sizeof p->store_path, "%s/.%s.frames", p->dir,
+             p->name);
+  /* a killed run's file is replaced; never through a link (issue 36) */
+  unlink(p->store_path);
+  int fd = open(p->store_path, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW, 0600);
+  if (fd >= 0)
+    p->store = fdopen(fd, "w+b");
+  if (!p->store) {
+    int e = errno;
+    if (fd >= 0)
+      close(fd);
+    p->store_path[0] = '\0';
+    return sph_error_at(err, SPH_ERR_IO, p->dir, 0, 0, NULL,
+                        "cannot create the frames' scratch file: %s",
+                        strerror(e));
+  }
+  return SPH_OK;
+}
+
+/* fwrite/fread of n items or an error naming the scratch file */
+static sph_status store_io(png_sink *p, void *buf, size_t size, size_t n,
+                           int writing, sph_error *err) {
+  if (n == 0)
+    return SPH_OK;
+  size_t got =
+      writing ? fwrite(buf, size, n, p->store) : fread(buf, size, n, p->store);
+  if (got != n)
+    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                        "cannot %s the frames' scratch file",
+                        writing ? "write" : "read");
+  return SPH_OK;
+}
+
+/* A record's arrays, in the order the sink's buffers hold them. */
+static sph_status store_arrays(png_sink *p, png_frame *fr, size_t m,
+                               int writing, sph_error *err) {
+  SPH_TRY(store_io(p, fr->xyz, sizeof *fr->xyz, 3 * m, writing, err));
+  if (fr->scale)
+    SPH_TRY(store_io(p, fr->scale, sizeof *fr->scale, m, writing, err));
+  SPH_TRY(store_io(p, fr->value, sizeof *fr->value, m, writing, err));
+  if (fr->key)
+    SPH_TRY(store_io(p, fr->key, sizeof *fr->key, m, writing, err));
+  if (p->domain && p->ghost)
+    SPH_TRY(
+        store_io(p, p->ghost_xyz, sizeof *p->ghost_xyz, 3 * m, writing, err));
+  return SPH_OK;
+}
+
+sph_status sph_png_store_put(png_sink *p, const png_frame *fr, int drawn,
+                             sph_error *err) {
+  if (!p->store)
+    return SPH_OK;
+  png_record r;
+  memset(&r, 0, sizeof r);
+  r.index = fr->index;
+  r.drawn = drawn;
+  r.time = fr->time;
+  r.lo = fr->lo;
+  r.hi = fr->hi;
+  r.vmin = fr->vmin;
+  r.vmax = fr->vmax;
+  r.view = fr->view;
+  r.m = fr->m;
+  SPH_TRY(store_io(p, &r, sizeof r, 1, 1, err));
+  return store_arrays(p, (png_frame *)fr, fr->m, 1, err);
+}
+
+/* The run-wide range as the frames show it (a field that never varied:
+ * centre +- 1, or [0, 1]). */
+void sph_png_final_range(const png_sink *p, double *lo, double *hi) {
+  int diverging = isfinite(p->centre);
+  double c0 = diverging ? p->centre : 0.0;
+  *lo = p->have_range ? p->lo : (diverging ? c0 - 1.0 : 0.0);
+  *hi = p->have_range ? p->hi : (diverging ? c0 + 1.0 : 1.0);
+}
+
+/* One frame drawn (over MPI ranks: collectively). */
+static sph_status store_draw(png_sink *p, const png_frame *fr, sph_error *err) {
+  return p->domain ? sph_png_render_ranks(p, fr, err)
+                   : sph_png_render(p, fr, err);
+}
+
+/* Every record drawn with another range or camera than the run's final
+ * ones is drawn again with them (collective over MPI ranks: the records'
+ * headers are the same on every rank). */
+static sph_status store_redraw(png_sink *p, sph_error *err) {
+  double lo, hi;
+  sph_png_final_range(p, &lo, &hi);
+  png_frame *fr = &p->slot[0];
+  if (fflush(p->store) != 0 || fseek(p->store, 0, SEEK_SET) != 0)
+    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                        "cannot read the frames' scratch file back");
+  png_record r;
+  while (fread(&r, sizeof r, 1, p->store) == 1) {
+    if (r.m > (p->domain ? p->cap : p->nkeep))
+      return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                          "damaged frames' scratch file");
+    int same = r.drawn && r.lo == lo && r.hi == hi &&
+               !memcmp(&r.view, &p->view, sizeof r.view);
+    if (same) { /* its arrays skipped */
+      long bytes =
+          (long)r.m *
+          (long)(3 * sizeof *fr->xyz + sizeof *fr->value +
+                 (fr->scale ? sizeof *fr->scale : 0) +
+                 (fr->key ? sizeof *fr->key : 0) +
+                 (p->domain && p->ghost ? 3 * sizeof *p->ghost_xyz : 0));
+      if (fseek(p->store, bytes, SEEK_CUR) != 0)
+        return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                            "cannot read the frames' scratch file back");
+      continue;
+    }
+    SPH_TRY(store_arrays(p, fr, (size_t)r.m, 0, err));
+    fr->m = (size_t)r.m;
+    fr->index = r.index;
+    fr->time = r.time;
+    fr->lo = lo;
+    fr->hi = hi;
+    fr->vmin = r.vmin;
+    fr->vmax = r.vmax;
+    fr->clamped_low = r.vmin < lo;
+    fr->clamped_high = r.vmax > hi;
+    fr->view = p->view;
+    SPH_TRY(store_draw(p, fr, err));
+    p->redrawn++;
+  }
+  if (ferror(p->store))
+    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                        "cannot read the frames' scratch file back");
+  return SPH_OK;
+}
+
+sph_status sph_png_store_finish(png_sink *p, sph_error *err) {
+  if (!p->store)
+    return SPH_OK;
+  double t0 = sph_wtime();
+  sph_status st = SPH_OK;
+  if (!p->gl) /* the render thread has ended: the context is made here */
+    st = sph_png_renderer_create(p, err);
+  if (st == SPH_OK)
+    st = store_redraw(p, err);
+  if (p->domain)
+    st = sph_domain_agree(p->domain, st, err);
+  p->redraw_seconds += sph_wtime() - t0;
+  sph_png_store_remove(p);
+  return st;
+}
+
+void sph_png_store_remove(png_sink *p) {
+  if (p->store)
+    fclose(p->store);
+  p->store = NULL;
+  if (p->store_path[0])
+    unlink(p->store_path);
+  p->store_path[0] = '\0';
+}
