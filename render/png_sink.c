@@ -331,7 +331,7 @@ static sph_status png_close(sph_sink *sink, sph_error *err) {
   sph_png_stop(p);
   if (st == SPH_OK)
     st = sph_png_store_finish(p, err);
-  sink->thread_seconds = p->busy + p->redraw_seconds;
+  sink->thread_seconds = p->busy;
   return st;
 }
 
@@ -344,7 +344,7 @@ static void png_destroy(sph_sink *sink) {
     pthread_cond_destroy(&p->cv);
     pthread_mutex_destroy(&p->mu);
   }
-  sink->thread_seconds = p->busy + p->redraw_seconds;
+  sink->thread_seconds = p->busy;
   sph_png_store_remove(p);
   sph_png_renderer_destroy(p);
   sph_image_destroy(&p->img);
