@@ -38,8 +38,12 @@ static void png_layers(png_sink *p, const png_frame *fr,
   layers[1] = (sph_gl_layer){
       ng,   p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1,
       NULL, fr->key};
-  layers[2] = (sph_gl_layer){m,     fr->xyz, (float)(0.5 * dp), p->rgb,
-                             plane, 0,       fr->scale,         fr->key};
+  /* the sphere (3D) or disc (2D) of the particle's volume dp^d at J = 1:
+   * the body looks solid at any spacing, without lattice gaps */
+  double r = p->dim == 3 ? cbrt(3.0 / (4.0 * 3.14159265358979323846)) * dp
+                         : sqrt(1.0 / 3.14159265358979323846) * dp;
+  layers[2] = (sph_gl_layer){m,     fr->xyz, (float)r,  p->rgb,
+                             plane, 0,       fr->scale, fr->key};
 }
 
 static sph_status png_overlay_write(png_sink *p, const png_frame *fr,

@@ -127,9 +127,10 @@ static void png_colour_range(png_sink *p, png_frame *s, double vmin,
   sph_png_final_range(p, &s->lo, &s->hi);
   s->vmin = vmin;
   s->vmax = vmax;
-  /* some finite value outside the range: the bar's end arrows */
-  s->clamped_low = vmin < s->lo;
-  s->clamped_high = vmax > s->hi;
+  /* some finite value of the run outside the range: the bar's end arrows
+   * (the same in every frame: the bar is the run's) */
+  s->clamped_low = p->run_min < s->lo;
+  s->clamped_high = p->run_max > s->hi;
 }
 
 /* The sphere of a particle's volume V0 J: J^(1/dim), within [0.5, 2]. */
@@ -193,11 +194,9 @@ sph_status sph_png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
     png_take(p, fr->ps, a, v, s, m++);
   }
   SPH_TRY(png_finite(s, m, err));
-  if (p->follow) {
-    double lo[3], hi[3];
-    sph_png_box(s->xyz, m, lo, hi);
-    sph_png_follow(p, lo, hi);
-  }
+  sph_png_box(s->xyz, m, s->box_lo, s->box_hi);
+  if (p->follow)
+    sph_png_follow(p, s->box_lo, s->box_hi);
   s->view = p->view;
   s->m = m;
   png_colour_range(p, s, vmin, vmax, amax);
@@ -246,6 +245,8 @@ sph_status sph_png_snapshot_ranks(png_sink *p, const sph_frame *fr,
   sph_png_box(s->xyz, m, lo, hi);
   lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
   sph_domain_minmax(p->domain, lo, hi, 5);
+  memcpy(s->box_lo, lo, sizeof s->box_lo);
+  memcpy(s->box_hi, hi, sizeof s->box_hi);
   if (p->follow)
     sph_png_follow(p, lo, hi);
   s->view = p->view;
@@ -279,6 +280,8 @@ static void replay_frame(png_sink *p, const sph_particles *ps, const double *x,
   sph_png_box(s->xyz, m, lo, hi);
   lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
   sph_domain_minmax(p->domain, lo, hi, 5);
+  memcpy(s->box_lo, lo, sizeof s->box_lo);
+  memcpy(s->box_hi, hi, sizeof s->box_hi);
   if (p->follow)
     sph_png_follow(p, lo, hi);
   s->view = p->view;

@@ -8,16 +8,17 @@
  * on that value, every other field (von Mises, density, vector and tensor
  * magnitudes) viridis over its own range. One range for the whole run
  * (png_store.c draws again, at close, every frame drawn with a range or
- * camera that later widened): `robust` (the default) from the frames' 1st
- * to 99th percentiles, the least 1st and the greatest 99th of any frame
- * (centre +- the greatest 99th percentile of |f - centre| for a diverging
- * map), so a few extreme particles (clamp corners, a punch edge) do not set
+ * camera that changed later): `robust` (the default) the 1st to 99th
+ * percentile of every value the run draws, pooled over its frames (a
+ * histogram of 65536 bins, 0.8 % wide; centre +- the 99th percentile of
+ * |f - centre| for a diverging map), so neither a few extreme particles
+ * (clamp corners, a punch edge) nor a few frames (an impact's transient) set
  * it; `auto` the least and greatest value of the run, `symmetric` centre
  * +- the largest distance from it, `global` as `auto`; `fixed [min, max]`
  * as given. NaN values get the map's own NaN colour. Camera: with `follow`
  * (the default of a fitted camera) the fit of the union of every frame's
- * drawn particles over the run (the bodies' extent, padded by half a
- * spacing and 2 %), orthographic unless `projection: perspective`; without
+ * drawn particles over the run (the bodies' extent, padded by a sphere's
+ * radius and 2 %), orthographic unless `projection: perspective`; without
  * it the fit of the bodies' initial bounding box enlarged by 10 % on each
  * side for the motion; a scene's position gives the view itself (then the
  * clip range and ortho height are fitted to that box seen from there).

@@ -29,6 +29,7 @@ typedef struct png_frame {
   double *value; /* their colour values (NaN: none) */
   double lo, hi; /* colour range of this frame */
   double vmin, vmax; /* its finite values' extremes (over ranks: all) */
+  double box_lo[3], box_hi[3]; /* the drawn particles' box (over ranks) */
   int clamped_low, clamped_high;
   sph_view view; /* the camera of this frame (follow) */
   double time;
@@ -72,6 +73,8 @@ typedef struct png_sink {
   char store_path[1200];
   int deferred;          /* frames drawn only at close (sph render) */
   int redrawn;           /* frames drawn again at close */
+  size_t nrec;           /* frames recorded */
+  double *boxes;         /* close, follow: every frame's box, then view's */
   double redraw_seconds; /* wall seconds close spent drawing them */
   /* renderer: only the render thread (or, without one, the caller) */
   sph_gl *gl;
@@ -143,6 +146,10 @@ int sph_png_cut_keeps(const double *c, int axis, double sign, double dp,
                       const double *X, const int32_t *body, size_t a);
 /* The box of m positions (lo > hi when m is 0). */
 void sph_png_box(const float *xyz, size_t m, double lo[3], double hi[3]);
+/* The fitted camera framing the drawn box [lo, hi] (padded by a sphere's
+ * radius and 2 % of each side). */
+void sph_png_fit_box(const png_sink *p, const double lo[3], const double hi[3],
+                     sph_view *v);
 /* Follow camera: the drawn box [lo, hi] joins the run's union of boxes;
  * p->view is refitted to the union when it grew. */
 void sph_png_follow(png_sink *p, const double box_lo[3],

@@ -26,6 +26,7 @@
 typedef struct png_record {
   int32_t index, drawn; /* drawn: 0 for a frame not drawn yet (resume) */
   double time, lo, hi, vmin, vmax;
+  double box_lo[3], box_hi[3];
   sph_view view;
   uint64_t m;
 } png_record;
@@ -96,9 +97,12 @@ sph_status sph_png_store_put(png_sink *p, const png_frame *fr, int drawn,
   r.hi = fr->hi;
   r.vmin = fr->vmin;
   r.vmax = fr->vmax;
+  memcpy(r.box_lo, fr->box_lo, sizeof r.box_lo);
+  memcpy(r.box_hi, fr->box_hi, sizeof r.box_hi);
   r.view = fr->view;
   r.m = fr->m;
   SPH_TRY(store_io(p, &r, sizeof r, 1, 1, err));
+  p->nrec++;
   return store_arrays(p, (png_frame *)fr, fr->m, 1, err);
 }
 
@@ -117,33 +121,113 @@ static sph_status store_draw(png_sink *p, const png_frame *fr, sph_error *err) {
                    : sph_png_render(p, fr, err);
 }
 
+/* Skips the arrays of a record of m particles. */
+static sph_status store_skip(png_sink *p, uint64_t m, sph_error *err) {
+  const png_frame *fr = &p->slot[0];
+  long bytes =
+      (long)m * (long)(3 * sizeof *fr->xyz + sizeof *fr->value +
+                       (fr->scale ? sizeof *fr->scale : 0) +
+                       (fr->key ? sizeof *fr->key : 0) +
+                       (p->domain && p->ghost ? 3 * sizeof *p->ghost_xyz : 0));
+  if (fseek(p->store, bytes, SEEK_CUR) != 0)
+    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                        "cannot read the frames' scratch file back");
+  return SPH_OK;
+}
+
+static sph_status store_rewind(png_sink *p, sph_error *err) {
+  if (fflush(p->store) != 0 || fseek(p->store, 0, SEEK_SET) != 0)
+    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                        "cannot read the frames' scratch file back");
+  return SPH_OK;
+}
+
+/* The least envelope of the half widths h[0 .. n) (stride 6) that
+ * changes by at most the factor 1 + r from one frame to the next and
+ * never falls below h: max over j of h[j] / (1 + r)^|i - j|. */
+static void envelope(double *h, size_t n, double r) {
+  for (size_t i = 1; i < n; ++i)
+    h[6 * i] = fmax(h[6 * i], h[6 * (i - 1)] / (1.0 + r));
+  for (size_t i = n - 1; i-- > 0;)
+    h[6 * i] = fmax(h[6 * i], h[6 * (i + 1)] / (1.0 + r));
+}
+
+static double diagonal(const double *lo, const double *hi) {
+  double d = 0.0;
+  for (int k = 0; k < 3; ++k)
+    d += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  return sqrt(d);
+}
+
+/* follow: every frame's box from the records (p->boxes, lo and hi), and
+ * whether the bodies travel: the run's union of boxes more than 1.3 times
+ * the smallest frame's box (diagonals; the rings parting, a falling body).
+ * Then each frame is framed on its own box's centre with half widths
+ * widened to an envelope that changes by at most 5 % a frame, so the view
+ * follows smoothly and the bodies' scale on screen changes by at most 5 %
+ * a frame; otherwise every frame shares the fit of the union (p->view). */
+static sph_status store_boxes(png_sink *p, int *travel, sph_error *err) {
+  *travel = 0;
+  size_t n = p->nrec;
+  if (!p->follow || n < 2)
+    return SPH_OK;
+  p->boxes = malloc(6 * n * sizeof *p->boxes);
+  if (!p->boxes)
+    return sph_error_set(err, SPH_ERR_NOMEM, "png sink: frame boxes");
+  SPH_TRY(store_rewind(p, err));
+  png_record r;
+  double least = INFINITY;
+  for (size_t i = 0; i < n; ++i) {
+    SPH_TRY(store_io(p, &r, sizeof r, 1, 0, err));
+    SPH_TRY(store_skip(p, r.m, err));
+    memcpy(p->boxes + 6 * i, r.box_lo, sizeof r.box_lo);
+    memcpy(p->boxes + 6 * i + 3, r.box_hi, sizeof r.box_hi);
+    if (!(r.box_lo[0] <= r.box_hi[0]))
+      return SPH_OK; /* a frame with nothing drawn: the union's fit */
+    least = fmin(least, diagonal(r.box_lo, r.box_hi));
+  }
+  if (!(diagonal(p->box_lo, p->box_hi) > 1.3 * least))
+    return SPH_OK;
+  *travel = 1;
+  for (size_t i = 0; i < n; ++i) /* centres and half widths */
+    for (int k = 0; k < 3; ++k) {
+      double *b = p->boxes + 6 * i;
+      double c = 0.5 * (b[k] + b[3 + k]), h = 0.5 * (b[3 + k] - b[k]);
+      b[k] = c;
+      b[3 + k] = h;
+    }
+  for (int k = 0; k < 3; ++k)
+    envelope(p->boxes + 3 + k, n, 0.05);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      double *b = p->boxes + 6 * i, c = b[k], h = b[3 + k];
+      b[k] = c - h;
+      b[3 + k] = c + h;
+    }
+  return SPH_OK;
+}
+
 /* Every record drawn with another range or camera than the run's final
  * ones is drawn again with them (collective over MPI ranks: the records'
  * headers are the same on every rank). */
 static sph_status store_redraw(png_sink *p, sph_error *err) {
   double lo, hi;
   sph_png_final_range(p, &lo, &hi);
+  int travel;
+  SPH_TRY(store_boxes(p, &travel, err));
   png_frame *fr = &p->slot[0];
-  if (fflush(p->store) != 0 || fseek(p->store, 0, SEEK_SET) != 0)
-    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
-                        "cannot read the frames' scratch file back");
+  SPH_TRY(store_rewind(p, err));
   png_record r;
-  while (fread(&r, sizeof r, 1, p->store) == 1) {
+  for (size_t i = 0; fread(&r, sizeof r, 1, p->store) == 1; ++i) {
     if (r.m > (p->domain ? p->cap : p->nkeep))
       return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
                           "damaged frames' scratch file");
-    int same = r.drawn && r.lo == lo && r.hi == hi &&
-               !memcmp(&r.view, &p->view, sizeof r.view);
-    if (same) { /* its arrays skipped */
-      long bytes =
-          (long)r.m *
-          (long)(3 * sizeof *fr->xyz + sizeof *fr->value +
-                 (fr->scale ? sizeof *fr->scale : 0) +
-                 (fr->key ? sizeof *fr->key : 0) +
-                 (p->domain && p->ghost ? 3 * sizeof *p->ghost_xyz : 0));
-      if (fseek(p->store, bytes, SEEK_CUR) != 0)
-        return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
-                            "cannot read the frames' scratch file back");
+    sph_view view = p->view;
+    if (travel && i < p->nrec)
+      sph_png_fit_box(p, p->boxes + 6 * i, p->boxes + 6 * i + 3, &view);
+    if (r.drawn && r.lo == lo && r.hi == hi &&
+        !memcmp(&r.view, &view, sizeof r.view)) {
+      SPH_TRY(store_skip(p, r.m, err));
       continue;
     }
     SPH_TRY(store_arrays(p, fr, (size_t)r.m, 0, err));
@@ -154,9 +238,9 @@ static sph_status store_redraw(png_sink *p, sph_error *err) {
     fr->hi = hi;
     fr->vmin = r.vmin;
     fr->vmax = r.vmax;
-    fr->clamped_low = r.vmin < lo;
-    fr->clamped_high = r.vmax > hi;
-    fr->view = p->view;
+    fr->clamped_low = p->run_min < lo;
+    fr->clamped_high = p->run_max > hi;
+    fr->view = view;
     SPH_TRY(store_draw(p, fr, err));
     p->redrawn++;
   }
@@ -183,6 +267,8 @@ sph_status sph_png_store_finish(png_sink *p, sph_error *err) {
 }
 
 void sph_png_store_remove(png_sink *p) {
+  free(p->boxes);
+  p->boxes = NULL;
   if (p->store)
     fclose(p->store);
   p->store = NULL;

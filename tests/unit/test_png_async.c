@@ -262,8 +262,7 @@ START_TEST(test_thread_error) {
     assert_frame_error(sink.ops->close(&sink, &err), &err, 4);
   } else { /* the frames' scratch file outgrew the limit first */
     ck_assert_int_eq(st4, SPH_ERR_IO);
-    ck_assert_msg(strstr(err.file, ".twisting_column.frames"), "%s",
-                  err.file);
+    ck_assert_msg(strstr(err.file, ".twisting_column.frames"), "%s", err.file);
   }
   ck_assert_int_eq(setrlimit(RLIMIT_FSIZE, &saved), 0);
   sink.ops->destroy(&sink);
