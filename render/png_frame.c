@@ -110,13 +110,9 @@ static void png_robust_range(png_sink *p) {
   p->have_range = 1;
 }
 
-/* The frame's colour range from its values' least, greatest and largest
- * distance from the centre (over MPI ranks: all ranks'), as the range
- * policy says: robust from the histogram of the run's values so far, auto
- * and symmetric the run's extremes so far; the frame is drawn with that
- * range (png_store.c draws it again with the run's final one). */
-static void png_colour_range(png_sink *p, png_frame *s, double vmin,
-                             double vmax, double amax) {
+void sph_png_range_update(png_sink *p, double vmin, double vmax) {
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  double amax = vmax >= vmin ? fmax(fabs(vmin - c0), fabs(vmax - c0)) : 0.0;
   p->run_min = fmin(p->run_min, vmin);
   p->run_max = fmax(p->run_max, vmax);
   p->run_amax = fmax(p->run_amax, amax);
@@ -124,6 +120,17 @@ static void png_colour_range(png_sink *p, png_frame *s, double vmin,
     png_robust_range(p);
   else
     png_grow_range(p, vmin, vmax, amax);
+}
+
+/* The frame's colour range from its values' least, greatest and largest
+ * distance from the centre (over MPI ranks: all ranks'), as the range
+ * policy says: robust from the histogram of the run's values so far, auto
+ * and symmetric the run's extremes so far; the frame is drawn with that
+ * range (png_store.c draws it again with the run's final one). */
+static void png_colour_range(png_sink *p, png_frame *s, double vmin,
+                             double vmax, double amax) {
+  (void)amax; /* the largest distance of [vmin, vmax] from the centre */
+  sph_png_range_update(p, vmin, vmax);
   sph_png_final_range(p, &s->lo, &s->hi);
   s->vmin = vmin;
   s->vmax = vmax;
@@ -141,8 +148,8 @@ static float png_radius_factor(int dim, double J) {
 
 /* Particle a's position, radius factor and colour value as the m-th drawn
  * sphere of snapshot s. */
-static void png_take(const png_sink *p, const sph_particles *ps, size_t a,
-                     double v, png_frame *s, size_t m) {
+static void png_take(png_sink *p, const sph_particles *ps, size_t a, double v,
+                     png_frame *s, size_t m) {
   const double *x = ps->field[SPH_FIELD_POSITION];
   const double *J = ps->field[SPH_FIELD_JACOBIAN];
   for (int c = 0; c < 3; ++c)
@@ -150,10 +157,11 @@ static void png_take(const png_sink *p, const sph_particles *ps, size_t a,
   if (s->scale)
     s->scale[m] = J ? png_radius_factor(p->dim, J[a]) : 1.0f;
   s->value[m] = v;
+  sph_png_hist_add(p, v);
 }
 
 /* A finite colour value v into the frame's least, greatest and largest
- * distance from the centre c0, and (robust) the run's histogram. */
+ * distance from the centre c0. */
 static void png_count(png_sink *p, double v, double c0, double *vmin,
                       double *vmax, double *amax) {
   if (!isfinite(v))
@@ -161,8 +169,13 @@ static void png_count(png_sink *p, double v, double c0, double *vmin,
   *vmin = fmin(*vmin, v);
   *vmax = fmax(*vmax, v);
   *amax = fmax(*amax, fabs(v - c0));
-  if (p->hist)
-    p->hist[hist_bin(isfinite(p->centre) ? fabs(v - c0) : v)]++;
+}
+
+void sph_png_hist_add(png_sink *p, double v) {
+  if (!p->hist || !isfinite(v))
+    return;
+  double c0 = isfinite(p->centre) ? p->centre : 0.0;
+  p->hist[hist_bin(isfinite(p->centre) ? fabs(v - c0) : v)]++;
 }
 
 /* A non-finite position fails here, as the sphere pass would, so the
@@ -275,6 +288,7 @@ static void replay_frame(png_sink *p, const sph_particles *ps, const double *x,
     if (s->scale)
       s->scale[m] = J ? png_radius_factor(p->dim, J[j]) : 1.0f;
     s->value[m++] = val;
+    sph_png_hist_add(p, val);
   }
   double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
   sph_png_box(s->xyz, m, lo, hi);
@@ -289,16 +303,23 @@ static void replay_frame(png_sink *p, const sph_particles *ps, const double *x,
   png_colour_range(p, s, lo[3], hi[3], hi[4]);
 }
 
-/* A resumed run's frames 0 .. frames - 1 are replayed from their .vtp files
- * (positions, the colour field, J), so the run-wide range and camera
- * include them, and (serial runs) recorded in the scratch file as not
- * drawn, so close draws them again with the final ones. Without the files
+/* A resumed run's frames 0 .. frames - 1 are taken back from the stopped
+ * run's scratch file (png_store.c), exactly as recorded, and drawn again
+ * at close with the final range and camera. Without it (a run killed with
+ * SIGKILL: records not on disk yet) they are replayed from their .vtp
+ * files (positions, the colour field, J: without J in the files the
+ * spheres of those frames take the factor 1), so the run-wide range and
+ * camera include them, and (serial runs) recorded in the scratch file as
+ * not drawn, so close draws them again with the final ones. Without the
+ * files
  * (vtk off, the field not among output.fields), or over MPI ranks (their
  * pieces are not recorded; with migrating particles not even replayed),
  * the frames written before stay as they were drawn. */
 sph_status sph_png_replay(png_sink *p, const sph_sim *sim, const char *dir,
                           int frames, sph_error *err) {
-  if (frames <= 0 || !sim->scene->output.vtk || sph_domain_migrates(p->domain))
+  if (frames <= 0 || sph_png_store_resume(p, frames, err))
+    return SPH_OK;
+  if (!sim->scene->output.vtk || sph_domain_migrates(p->domain))
     return SPH_OK;
   const sph_particles *ps = sim->ps;
   size_t n = ps->n ? ps->n : 1;

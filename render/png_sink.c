@@ -243,7 +243,7 @@ static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
   threaded = p->threaded;
   sph_status st = png_setup(p, sim, dir, err);
   if (st == SPH_OK)
-    st = sph_png_store_open(p, err);
+    st = sph_png_store_open(p, sink->resume_frames, err);
   SPH_TRY(sph_domain_agree(sim->domain, st, err)); /* before the replay's */
   st = sph_png_replay(p, sim, dir, sink->resume_frames, err);
   SPH_TRY(sph_domain_agree(sim->domain, st, err));
@@ -331,7 +331,7 @@ static sph_status png_close(sph_sink *sink, sph_error *err) {
   sph_status st = sph_png_wait(p, err);
   sph_png_stop(p);
   if (st == SPH_OK)
-    st = sph_png_store_finish(p, err);
+    st = sph_png_store_finish(p, sink->stopping, err);
   sink->thread_seconds = p->busy;
   return st;
 }

@@ -74,6 +74,8 @@ typedef struct png_sink {
   int deferred;          /* frames drawn only at close (sph render) */
   int redrawn;           /* frames drawn again at close */
   size_t nrec;           /* frames recorded */
+  size_t forced;         /* the first records, taken back on resume: drawn
+                            again at close whatever their range */
   double *boxes;         /* close, follow: every frame's box, then view's */
   double redraw_seconds; /* wall seconds close spent drawing them */
   /* renderer: only the render thread (or, without one, the caller) */
@@ -157,6 +159,12 @@ void sph_png_follow(png_sink *p, const double box_lo[3],
 
 /* --- png_frame.c: snapshots, colour range, a resumed run's replay ------- */
 
+/* A drawn value v joins the run's histogram (robust). */
+void sph_png_hist_add(png_sink *p, double v);
+/* The run's extremes widened by a frame's [vmin, vmax], the range
+ * recomputed (all policies but fixed). */
+void sph_png_range_update(png_sink *p, double vmin, double vmax);
+
 /* Copies what frame fr needs into snapshot s and advances the range (frame
  * order, on the simulation thread). */
 sph_status sph_png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
@@ -193,16 +201,21 @@ void sph_png_stop(png_sink *p);
 /* --- png_store.c: the frames' scratch file, drawn again at close ------- */
 
 /* Creates frames/.<scene>.frames (.pR over MPI ranks), replacing a killed
- * run's. */
-sph_status sph_png_store_open(png_sink *p, sph_error *err);
+ * run's; resuming (resume_frames > 0), opens the stopped run's instead. */
+sph_status sph_png_store_open(png_sink *p, int resume_frames, sph_error *err);
+/* Resuming: the stopped run's records of frames 0 .. frames - 1 taken
+ * back (range, camera, to be drawn again at close) and the rest dropped;
+ * 0 when the file does not hold them all (then it is emptied). */
+int sph_png_store_resume(png_sink *p, int frames, sph_error *err);
 /* Appends frame fr (drawn: 0 when it is not drawn yet). */
 sph_status sph_png_store_put(png_sink *p, const png_frame *fr, int drawn,
                              sph_error *err);
 /* The run-wide colour range the frames show. */
 void sph_png_final_range(const png_sink *p, double *lo, double *hi);
 /* Draws again (on the calling thread) every frame drawn with another range
- * or camera than the final ones, then removes the file (collective). */
-sph_status sph_png_store_finish(png_sink *p, sph_error *err);
+ * or camera than the final ones, then removes the file (keep: a stopped
+ * run's is kept for --resume) (collective). */
+sph_status sph_png_store_finish(png_sink *p, int keep, sph_error *err);
 /* Closes and removes the file (after a failure). */
 void sph_png_store_remove(png_sink *p);
 

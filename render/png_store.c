@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "render/png_sink_impl.h"
@@ -31,18 +32,29 @@ typedef struct png_record {
   uint64_t m;
 } png_record;
 
-sph_status sph_png_store_open(png_sink *p, sph_error *err) {
+sph_status sph_png_store_open(png_sink *p, int resume_frames, sph_error *err) {
   if (p->domain)
     snprintf(p->store_path, sizeof p->store_path, "%s/.%s.frames.p%d", p->dir,
              p->name, p->rank);
   else
     snprintf(p->store_path, sizeof p->store_path, "%s/.%s.frames", p->dir,
              p->name);
-  /* a killed run's file is replaced; never through a link (issue 36) */
-  unlink(p->store_path);
-  int fd = open(p->store_path, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW, 0600);
+  /* resuming: the stopped run's file, when it is one (never a link) */
+  int fd = resume_frames > 0
+               ? open(p->store_path, O_RDWR | O_NOFOLLOW | O_CLOEXEC)
+               : -1;
+  struct stat st;
+  if (fd >= 0 && (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))) {
+    close(fd);
+    fd = -1;
+  }
+  if (fd < 0) { /* a killed run's file is replaced */
+    unlink(p->store_path);
+    fd = open(p->store_path, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
+              0600);
+  }
   if (fd >= 0)
-    p->store = fdopen(fd, "w+b");
+    p->store = fdopen(fd, "r+b");
   if (!p->store) {
     int e = errno;
     if (fd >= 0)
@@ -102,8 +114,14 @@ sph_status sph_png_store_put(png_sink *p, const png_frame *fr, int drawn,
   r.view = fr->view;
   r.m = fr->m;
   SPH_TRY(store_io(p, &r, sizeof r, 1, 1, err));
+  SPH_TRY(store_arrays(p, (png_frame *)fr, fr->m, 1, err));
   p->nrec++;
-  return store_arrays(p, (png_frame *)fr, fr->m, 1, err);
+  /* on disk before the run goes on: a killed run's resume reads it */
+  if (fflush(p->store) != 0)
+    return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
+                        "cannot write the frames' scratch file: %s",
+                        strerror(errno));
+  return SPH_OK;
 }
 
 /* The run-wide range as the frames show it (a field that never varied:
@@ -140,6 +158,47 @@ static sph_status store_rewind(png_sink *p, sph_error *err) {
     return sph_error_at(err, SPH_ERR_IO, p->store_path, 0, 0, NULL,
                         "cannot read the frames' scratch file back");
   return SPH_OK;
+}
+
+int sph_png_store_resume(png_sink *p, int frames, sph_error *err) {
+  if (!p->store)
+    return 0;
+  png_frame *fr = &p->slot[0];
+  png_record r;
+  int n = 0;
+  long end = 0;
+  if (store_rewind(p, err) != SPH_OK)
+    return 0;
+  while (n < frames && fread(&r, sizeof r, 1, p->store) == 1 && r.index == n &&
+         r.m <= (p->domain ? p->cap : p->nkeep) &&
+         store_arrays(p, fr, (size_t)r.m, 0, err) == SPH_OK) {
+    for (size_t i = 0; i < r.m; ++i)
+      sph_png_hist_add(p, fr->value[i]);
+    sph_png_range_update(p, r.vmin, r.vmax);
+    if (p->follow)
+      sph_png_follow(p, r.box_lo, r.box_hi);
+    end = ftell(p->store);
+    ++n;
+  }
+  int whole = n == frames;
+  if (p->domain) /* every rank's file */
+    whole = sph_domain_min(p->domain, whole);
+  if (!whole) { /* not the records this resume needs: start afresh */
+    memset(p->hist, 0, p->hist ? PNG_HIST_BINS * sizeof *p->hist : 0);
+    p->run_min = INFINITY;
+    p->run_max = -INFINITY;
+    p->run_amax = 0.0;
+    p->have_range = p->mode == PNG_RANGE_FIXED;
+    p->have_box = 0;
+    end = 0;
+    n = 0;
+  }
+  /* the records after them (frames the resumed run writes again) dropped */
+  if (fflush(p->store) != 0 || ftruncate(fileno(p->store), end) != 0 ||
+      fseek(p->store, end, SEEK_SET) != 0)
+    return 0;
+  p->nrec = p->forced = (size_t)n;
+  return whole;
 }
 
 /* The least envelope of the half widths h[0 .. n) (stride 6) that
@@ -225,7 +284,7 @@ static sph_status store_redraw(png_sink *p, sph_error *err) {
     sph_view view = p->view;
     if (travel && i < p->nrec)
       sph_png_fit_box(p, p->boxes + 6 * i, p->boxes + 6 * i + 3, &view);
-    if (r.drawn && r.lo == lo && r.hi == hi &&
+    if (i >= p->forced && r.drawn && r.lo == lo && r.hi == hi &&
         !memcmp(&r.view, &view, sizeof r.view)) {
       SPH_TRY(store_skip(p, r.m, err));
       continue;
@@ -250,7 +309,7 @@ static sph_status store_redraw(png_sink *p, sph_error *err) {
   return SPH_OK;
 }
 
-sph_status sph_png_store_finish(png_sink *p, sph_error *err) {
+sph_status sph_png_store_finish(png_sink *p, int keep, sph_error *err) {
   if (!p->store)
     return SPH_OK;
   double t0 = sph_wtime();
@@ -262,6 +321,11 @@ sph_status sph_png_store_finish(png_sink *p, sph_error *err) {
   if (p->domain)
     st = sph_domain_agree(p->domain, st, err);
   p->redraw_seconds += sph_wtime() - t0;
+  if (keep && st == SPH_OK) { /* a stopped run's, for --resume */
+    fclose(p->store);
+    p->store = NULL;
+    p->store_path[0] = '\0';
+  }
   sph_png_store_remove(p);
   return st;
 }

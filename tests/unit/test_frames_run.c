@@ -6,7 +6,7 @@
  * consecutive frames as the rings collide and part (the follow camera of
  * before refitted in jumps of 14 and 21 %), the rings fill most of the
  * frame and never reach the bar's strip; and a run stopped by a signal
- * leaves frames sharing one bar too. */
+ * leaves frames sharing one bar too, as does its --resume. */
 #include "test_util.h"
 
 #include <math.h>
@@ -202,8 +202,7 @@ END_TEST
 
 START_TEST(stopped_run_one_bar) {
   /* SIGINT once two frames are drawn: the run stops between steps, its
-   * frames so far drawn again with the range and camera of the part run,
-   * and the scratch file removed */
+   * frames so far drawn again with the range and camera of the part run */
   char cmd[2048];
   snprintf(cmd, sizeof cmd,
            "OMP_NUM_THREADS=1 %s/sph run %s/scenes/twisting_column.yaml "
@@ -218,9 +217,21 @@ START_TEST(stopped_run_one_bar) {
   ck_assert_int_eq(system(cmd), 0);
   int frames = assert_one_bar("stop", "twisting_column");
   ck_assert(frames >= 2);
+  /* the scratch file kept for --resume, which draws every frame again with
+   * the whole run's range and camera, then removes it */
   char scratch[400];
   snprintf(scratch, sizeof scratch, "%s/stop/frames/.twisting_column.frames",
            dir);
+  ck_assert_msg(access(scratch, F_OK) == 0, "%s not kept", scratch);
+  snprintf(cmd, sizeof cmd,
+           "OMP_NUM_THREADS=1 %s/sph run %s/scenes/twisting_column.yaml "
+           "--resume %s/stop --quiet --threads 1 --set output.png.width=%d "
+           "--set output.png.height=%d --set output.png.mp4=false --set "
+           "output.vtk=false --set 'bodies.0.particles.count=[5,25,5]' "
+           "--set output.every=0.005 > /dev/null",
+           SPH_BINARY_DIR, SPH_SOURCE_DIR, dir, W, H);
+  ck_assert_int_eq(system(cmd), 0);
+  ck_assert_int_eq(assert_one_bar("stop", "twisting_column"), 61);
   ck_assert_msg(access(scratch, F_OK) != 0, "%s left behind", scratch);
 }
 END_TEST

@@ -208,12 +208,15 @@ static void set_file_limit(rlim_t bytes) {
   ck_assert_int_eq(setrlimit(RLIMIT_FSIZE, &r), 0);
 }
 
-/* err is an I/O error about frame `index`. */
+/* err is an I/O error about frame `index` (or, once the limit is below
+ * it, about the frames' scratch file, written at every frame). */
 static void assert_frame_error(sph_status st, const sph_error *err, int index) {
   char name[64];
   snprintf(name, sizeof name, "twisting_column_%04d.png", index);
   ck_assert_msg(st == SPH_ERR_IO, "status %s, expected SPH_ERR_IO",
                 sph_status_name(st));
+  if (index > 1 && strstr(err->file, ".twisting_column.frames"))
+    return;
   size_t lf = strlen(err->file), ln = strlen(name);
   ck_assert_msg(lf >= ln && !strcmp(err->file + lf - ln, name),
                 "error names '%s', expected frame %d", err->file, index);
@@ -244,16 +247,14 @@ START_TEST(test_thread_error) {
   ck_assert(sink.ops->write(&sink, &fr, &err) == SPH_OK);
   assert_frame_error(sink.ops->flush(&sink, &err), &err, 1);
   ck_assert(sink.ops->flush(&sink, &err) == SPH_OK); /* reported once */
-  /* reported by the next write once known (a write never waits for the
-   * render thread: while frame 2 renders, frame 3 is only recorded), else
-   * by flush */
+  /* the next frame's error, the render thread's (frame 2's file) or the
+   * scratch file's (written at every write), reported once, by the write
+   * or by the flush after it */
   fr.index = 2;
-  ck_assert(sink.ops->write(&sink, &fr, &err) == SPH_OK);
-  fr.index = 3;
-  sph_status st3 = sink.ops->write(&sink, &fr, &err);
-  if (st3 == SPH_OK)
-    st3 = sink.ops->flush(&sink, &err);
-  assert_frame_error(st3, &err, 2);
+  sph_status st2 = sink.ops->write(&sink, &fr, &err);
+  if (st2 == SPH_OK)
+    st2 = sink.ops->flush(&sink, &err);
+  assert_frame_error(st2, &err, 2);
   ck_assert(sink.ops->flush(&sink, &err) == SPH_OK);
   /* reported by close */
   fr.index = 4;
