@@ -122,14 +122,13 @@ void sph_png_range_update(png_sink *p, double vmin, double vmax) {
     png_grow_range(p, vmin, vmax, amax);
 }
 
-/* The frame's colour range from its values' least, greatest and largest
- * distance from the centre (over MPI ranks: all ranks'), as the range
+/* The frame's colour range from its values' least and greatest (over MPI
+ * ranks: all ranks'), as the range
  * policy says: robust from the histogram of the run's values so far, auto
  * and symmetric the run's extremes so far; the frame is drawn with that
  * range (png_store.c draws it again with the run's final one). */
 static void png_colour_range(png_sink *p, png_frame *s, double vmin,
-                             double vmax, double amax) {
-  (void)amax; /* the largest distance of [vmin, vmax] from the centre */
+                             double vmax) {
   sph_png_range_update(p, vmin, vmax);
   sph_png_final_range(p, &s->lo, &s->hi);
   s->vmin = vmin;
@@ -212,7 +211,7 @@ sph_status sph_png_snapshot(png_sink *p, const sph_frame *fr, png_frame *s,
     sph_png_follow(p, s->box_lo, s->box_hi);
   s->view = p->view;
   s->m = m;
-  png_colour_range(p, s, vmin, vmax, amax);
+  png_colour_range(p, s, vmin, vmax);
   s->time = fr->time;
   s->index = fr->index;
   return SPH_OK;
@@ -264,7 +263,7 @@ sph_status sph_png_snapshot_ranks(png_sink *p, const sph_frame *fr,
     sph_png_follow(p, lo, hi);
   s->view = p->view;
   s->m = m;
-  png_colour_range(p, s, lo[3], hi[3], hi[4]);
+  png_colour_range(p, s, lo[3], hi[3]);
   s->time = fr->time;
   s->index = fr->index;
   return SPH_OK;
@@ -300,7 +299,7 @@ static void replay_frame(png_sink *p, const sph_particles *ps, const double *x,
     sph_png_follow(p, lo, hi);
   s->view = p->view;
   s->m = m;
-  png_colour_range(p, s, lo[3], hi[3], hi[4]);
+  png_colour_range(p, s, lo[3], hi[3]);
 }
 
 /* A resumed run's frames 0 .. frames - 1 are taken back from the stopped
