@@ -159,6 +159,7 @@ sph_status sph_mp4_assemble(const char *dir, const char *scene, int frames,
   int x264 = has_libx264(ffmpeg);
   snprintf(info->codec, sizeof info->codec, "%s", x264 ? "libx264" : "mpeg4");
   info->frames = frames;
+  info->fps = fps;
   /* x264's veryfast preset: 45 % less time than its default, 3 % more bytes
    * (the twisting column's 61 frames, same crf) */
   static char *x264_quality[] = {"-preset", "veryfast", "-crf", "20"};

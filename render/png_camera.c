@@ -24,11 +24,17 @@ static void png_fit(const sph_scene *s, const double lo[3], const double hi[3],
   const sph_camera *c = &o->camera;
   const double deg = 3.14159265358979323846 / 180.0;
   int W = o->width, H = o->height;
+  /* the label block's height (sph_overlay_label: two lines of the
+   * overlay's font, its padding, at H / 36): over the share in small
+   * frames, whose font does not shrink below 12 px */
+  int px = H / 32 < 12 ? 12 : H / 32 > 40 ? 40 : H / 32;
+  int label = H / 36 + (int)ceil(2.5 * px) + 2 * (px / 3 < 3 ? 3 : px / 3);
+  int top = (int)(PNG_LABEL_SHARE * H);
   int we = (int)((1.0 - PNG_BAR_SHARE) * W),
-      he = (int)((1.0 - PNG_LABEL_SHARE) * H);
+      he = H - (label > top ? label : top);
   sph_view_fit(lo, hi, c->given ? c->azimuth : 30.0,
                c->given ? c->elevation : 20.0, c->given ? c->zoom : 1.0,
-               c->given ? c->orthographic : 0, s->dimension, we, he, v);
+               c->given ? c->orthographic : 1, s->dimension, we, he, v);
   double f[3], r[3], dist = 0.0;
   for (int k = 0; k < 3; ++k) {
     f[k] = v->target[k] - v->eye[k];
@@ -277,28 +283,34 @@ void sph_png_box(const float *xyz, size_t m, double lo[3], double hi[3]) {
     }
 }
 
-/* Follow camera: refit when a drawn particle leaves the framed box [lo, hi]
- * of the drawn particles, or when the bodies have shrunk to under half of
- * it along every axis (hysteresis: the view holds still while the motion
- * stays inside). Nothing for an empty box. */
+/* Follow camera: the drawn box [lo, hi] joins the union of every frame's
+ * box so far, and the view is the fit of that union padded by a sphere's
+ * radius and 2 % of each side (no room for motion: the union holds it).
+ * The camera only ever widens, never jumps back; png_store.c draws the
+ * frames again with the fit of the whole run's union. Nothing for an
+ * empty box. */
 void sph_png_follow(png_sink *p, const double box_lo[3],
                     const double box_hi[3]) {
   if (!(box_lo[0] <= box_hi[0]))
     return;
-  double lo[3], hi[3];
-  memcpy(lo, box_lo, sizeof lo);
-  memcpy(hi, box_hi, sizeof hi);
-  int outside = 0, small = 1;
+  int grew = !p->have_box;
   for (int k = 0; k < 3; ++k) {
-    double fit = p->fit_hi[k] - p->fit_lo[k];
-    outside |= lo[k] < p->fit_lo[k] || hi[k] > p->fit_hi[k];
-    if (fit > 4.0 * p->dp)
-      small &= hi[k] - lo[k] < 0.5 * fit;
+    grew |= box_lo[k] < p->box_lo[k] || box_hi[k] > p->box_hi[k];
+    p->box_lo[k] = p->have_box ? fmin(p->box_lo[k], box_lo[k]) : box_lo[k];
+    p->box_hi[k] = p->have_box ? fmax(p->box_hi[k], box_hi[k]) : box_hi[k];
   }
-  if (!outside && !small)
-    return;
-  png_pad(p->dp, lo, hi);
-  memcpy(p->fit_lo, lo, sizeof lo);
-  memcpy(p->fit_hi, hi, sizeof hi);
-  png_fit(p->scene, lo, hi, &p->view);
+  p->have_box = 1;
+  if (grew)
+    sph_png_fit_box(p, p->box_lo, p->box_hi, &p->view);
+}
+
+void sph_png_fit_box(const png_sink *p, const double lo[3], const double hi[3],
+                     sph_view *v) {
+  double a[3], b[3];
+  for (int k = 0; k < 3; ++k) {
+    double pad = 0.62 * p->dp + 0.02 * (hi[k] - lo[k]);
+    a[k] = lo[k] - pad;
+    b[k] = hi[k] + pad;
+  }
+  png_fit(p->scene, a, b, v);
 }

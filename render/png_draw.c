@@ -38,8 +38,12 @@ static void png_layers(png_sink *p, const png_frame *fr,
   layers[1] = (sph_gl_layer){
       ng,   p->ghost_xyz, (float)(GHOST_FILL * dp), p->ghost_fill, plane, 1,
       NULL, fr->key};
-  layers[2] = (sph_gl_layer){m,     fr->xyz, (float)(0.5 * dp), p->rgb,
-                             plane, 0,       fr->scale,         fr->key};
+  /* the sphere (3D) or disc (2D) of the particle's volume dp^d at J = 1:
+   * the body looks solid at any spacing, without lattice gaps */
+  double r = p->dim == 3 ? cbrt(3.0 / (4.0 * 3.14159265358979323846)) * dp
+                         : sqrt(1.0 / 3.14159265358979323846) * dp;
+  layers[2] = (sph_gl_layer){m,     fr->xyz, (float)r,  p->rgb,
+                             plane, 0,       fr->scale, fr->key};
 }
 
 static sph_status png_overlay_write(png_sink *p, const png_frame *fr,
@@ -153,6 +157,16 @@ void sph_png_renderer_destroy(png_sink *p) {
   sph_text_destroy(p->text);
   p->gl = NULL;
   p->text = NULL;
+}
+
+/* A snapshot recorded in the scratch file, then drawn (unless deferred). */
+sph_status sph_png_emit(png_sink *p, const png_frame *fr, sph_error *err) {
+  sph_status st = sph_png_store_put(p, fr, !p->deferred, err);
+  SPH_TRY(p->domain ? sph_domain_agree(p->domain, st, err) : st);
+  if (p->deferred)
+    return SPH_OK;
+  return p->domain ? sph_png_render_ranks(p, fr, err)
+                   : sph_png_render(p, fr, err);
 }
 
 /* Render thread: creates the renderer, then writes each frame handed over

@@ -6,18 +6,22 @@
  * Colour: the field chooses the map unless `colormap` is given: pressure
  * (signed about 0) and J (about 1) the diverging cool-to-warm map centred
  * on that value, every other field (von Mises, density, vector and tensor
- * magnitudes) viridis over its own range. Range policy: `robust` (the
- * default) per frame, the 1st to 99th percentile of the frame's values
- * (centre +- the 99th percentile of |f - centre| for a diverging map), so a
- * few extreme particles (clamp corners, a punch edge) or an early transient
- * do not wash the other frames out; `fixed [min, max]` as given;
- * `symmetric` centre +- max |f - centre| and `auto` [min, max] grow-only: a
- * frame widens the range when its values exceed it and never narrows it. A
- * run-wide `global` range needs every frame first; in a run it behaves as
- * `auto`. NaN values get the map's own NaN colour. The
- * camera frames the bodies' initial bounding box, enlarged by 10 % on each
- * side for the motion, unless the scene gives a position (then the clip
- * range and ortho height are fitted to that box seen from there).
+ * magnitudes) viridis over its own range. One range for the whole run
+ * (png_store.c draws again, at close, every frame drawn with a range or
+ * camera that changed later): `robust` (the default) the 1st to 99th
+ * percentile of every value the run draws, pooled over its frames (a
+ * histogram of 65536 bins, 0.8 % wide; centre +- the 99th percentile of
+ * |f - centre| for a diverging map), so neither a few extreme particles
+ * (clamp corners, a punch edge) nor a few frames (an impact's transient) set
+ * it; `auto` the least and greatest value of the run, `symmetric` centre
+ * +- the largest distance from it, `global` as `auto`; `fixed [min, max]`
+ * as given. NaN values get the map's own NaN colour. Camera: with `follow`
+ * (the default of a fitted camera) the fit of the union of every frame's
+ * drawn particles over the run (the bodies' extent, padded by a sphere's
+ * radius and 2 %), orthographic unless `projection: perspective`; without
+ * it the fit of the bodies' initial bounding box enlarged by 10 % on each
+ * side for the motion; a scene's position gives the view itself (then the
+ * clip range and ortho height are fitted to that box seen from there).
  *
  * Cutaways: `clip` keeps the particles with n . x <= at (current position,
  * the GL clip plane, whole spheres); `cut: half` keeps, per body, the
@@ -32,19 +36,22 @@
  *
  * Threading: `write` runs on the simulation thread only as long as it takes
  * to copy the kept particles' positions and colour values into one of two
- * snapshots allocated at `open` and to advance the range (in frame order,
- * so the colours never depend on timing); a render thread owned by the sink
- * makes the one OSMesa context current, draws, composites and writes the
- * frame. One frame is in flight: `write` waits only while the frame before
- * is still being rendered; `flush` and `close` wait for every frame handed
- * over. The render thread's first error (naming the frame's file) is
- * returned by the next write, flush or close. sph_png_sink_sync_ops
- * (sph/render.h) renders on the calling thread instead.
+ * snapshots allocated at `open`, to advance the range and camera (in frame
+ * order, so the frames never depend on timing) and to append the snapshot
+ * to the frames' scratch file; a render thread owned by the sink makes the
+ * one OSMesa context current, draws, composites and writes the frame. A
+ * frame is handed over only when the render thread is idle, so the run
+ * never waits for one; `close` draws the frames not drawn yet and those
+ * drawn with a range or camera that later widened, on the caller's thread.
+ * The render thread's first error (naming the frame's file) is returned by
+ * the next write, flush or close. sph_png_sink_sync_ops (sph/render.h)
+ * renders on the calling thread instead, sph_png_sink_batch_ops only at
+ * close (sph render).
  *
  * This file: the sink's set-up, open, write, close and ops tables; the
  * camera and cutaways are in png_camera.c, the snapshots and colour range
- * in png_frame.c, drawing and the render thread in png_draw.c (shared state:
- * png_sink_impl.h). */
+ * in png_frame.c, drawing and the render thread in png_draw.c, the scratch
+ * file and the redraw in png_store.c (shared state: png_sink_impl.h). */
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
@@ -128,9 +135,15 @@ static sph_status png_setup_buffers(png_sink *p, const sph_sim *sim,
     p->centre = 0.0;
   if (p->map == SPH_CMAP_VIRIDIS)
     p->centre = NAN;
-  p->work = malloc(n * sizeof *p->work);
-  if (!p->work)
-    return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  p->run_min = INFINITY;
+  p->run_max = -INFINITY;
+  p->run_amax = 0.0;
+  if (p->mode == PNG_RANGE_ROBUST) {
+    p->hist = calloc(PNG_HIST_BINS, sizeof *p->hist);
+    p->hist_all = p->domain ? calloc(PNG_HIST_BINS, sizeof *p->hist_all) : NULL;
+    if (!p->hist || (p->domain && !p->hist_all))
+      return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
+  }
   const char *unit = sph_field_unit(f);
   snprintf(p->title, sizeof p->title, "%s%s%s%s%s", sph_field_name(f),
            p->ncomp > 1 ? " magnitude" : "", unit && *unit ? " [" : "",
@@ -218,17 +231,22 @@ static sph_status png_setup(png_sink *p, const sph_sim *sim, const char *dir,
 }
 
 static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
-                              const char *dir, int threaded, sph_error *err) {
+                              const char *dir, int threaded, int deferred,
+                              sph_error *err) {
   png_sink *p = calloc(1, sizeof *p);
   if (!p)
     return sph_error_set(err, SPH_ERR_NOMEM, "png sink");
   sink->data = p;
   sink->thread_seconds = 0.0;
-  p->threaded = threaded && !sim->domain; /* collectives: one thread */
+  p->threaded = threaded && !deferred && !sim->domain; /* collectives */
+  p->deferred = deferred;
   threaded = p->threaded;
   sph_status st = png_setup(p, sim, dir, err);
+  if (st == SPH_OK)
+    st = sph_png_store_open(p, sink->resume_frames, err);
   SPH_TRY(sph_domain_agree(sim->domain, st, err)); /* before the replay's */
-  sph_png_replay(p, sim, dir, sink->resume_frames);
+  st = sph_png_replay(p, sim, dir, sink->resume_frames, err);
+  SPH_TRY(sph_domain_agree(sim->domain, st, err));
   if (!threaded)
     return sph_png_renderer_create(p, err);
   /* the render thread, which makes the GL context current on itself */
@@ -250,19 +268,24 @@ static sph_status png_open_as(sph_sink *sink, const sph_sim *sim,
 
 static sph_status png_open(sph_sink *sink, const sph_sim *sim, const char *dir,
                            sph_error *err) {
-  return png_open_as(sink, sim, dir, 1, err);
+  return png_open_as(sink, sim, dir, 1, 0, err);
 }
 
 static sph_status png_open_sync(sph_sink *sink, const sph_sim *sim,
                                 const char *dir, sph_error *err) {
-  return png_open_as(sink, sim, dir, 0, err);
+  return png_open_as(sink, sim, dir, 0, 0, err);
+}
+
+static sph_status png_open_batch(sph_sink *sink, const sph_sim *sim,
+                                 const char *dir, sph_error *err) {
+  return png_open_as(sink, sim, dir, 0, 1, err);
 }
 
 /* a render thread only where a core is left for it */
 static sph_status png_open_auto(sph_sink *sink, const sph_sim *sim,
                                 const char *dir, sph_error *err) {
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  return png_open_as(sink, sim, dir, sim->threads < cores, err);
+  return png_open_as(sink, sim, dir, sim->threads < cores, 0, err);
 }
 
 static sph_status png_write(sph_sink *sink, const sph_frame *fr,
@@ -271,13 +294,24 @@ static sph_status png_write(sph_sink *sink, const sph_frame *fr,
   png_frame *s = &p->slot[p->next];
   if (p->domain) { /* over MPI ranks: composited on this thread */
     SPH_TRY(sph_png_snapshot_ranks(p, fr, s, err));
-    return sph_png_render_ranks(p, s, err);
+    return sph_png_emit(p, s, err);
   }
   SPH_TRY(sph_png_snapshot(p, fr, s, err));
   if (!p->threaded)
-    return sph_png_render(p, s, err);
-  /* the frame before is done (or failed): hand this one over */
-  SPH_TRY(sph_png_wait(p, err));
+    return sph_png_emit(p, s, err);
+  /* handed over only when the render thread is idle: the run never waits
+   * for a frame; one not drawn now is drawn at close */
+  pthread_mutex_lock(&p->mu);
+  int idle = p->ready && !p->queued;
+  sph_status st = p->status;
+  if (st != SPH_OK && err)
+    *err = p->error;
+  p->status = SPH_OK;
+  pthread_mutex_unlock(&p->mu);
+  SPH_TRY(st);
+  SPH_TRY(sph_png_store_put(p, s, idle, err));
+  if (!idle)
+    return SPH_OK;
   pthread_mutex_lock(&p->mu);
   p->queued = s;
   pthread_cond_broadcast(&p->cv);
@@ -290,10 +324,14 @@ static sph_status png_flush(sph_sink *sink, sph_error *err) {
   return sph_png_wait(sink->data, err);
 }
 
+/* every frame handed over written, then those drawn with another range
+ * or camera than the run's final ones drawn again (png_store.c) */
 static sph_status png_close(sph_sink *sink, sph_error *err) {
   png_sink *p = sink->data;
   sph_status st = sph_png_wait(p, err);
   sph_png_stop(p);
+  if (st == SPH_OK)
+    st = sph_png_store_finish(p, sink->stopping, err);
   sink->thread_seconds = p->busy;
   return st;
 }
@@ -308,11 +346,13 @@ static void png_destroy(sph_sink *sink) {
     pthread_mutex_destroy(&p->mu);
   }
   sink->thread_seconds = p->busy;
+  sph_png_store_remove(p);
   sph_png_renderer_destroy(p);
   sph_image_destroy(&p->img);
   free(p->rgb);
   free(p->keep);
-  free(p->work);
+  free(p->hist);
+  free(p->hist_all);
   free(p->cut_c);
   free(p->order);
   free(p->cpx);
@@ -360,6 +400,17 @@ const sph_sink_ops sph_png_sink_sync_ops = {
     .enabled = png_enabled,
     .distributed = 1,
     .open = png_open_sync,
+    .write = png_write,
+    .flush = png_flush,
+    .close = png_close,
+    .destroy = png_destroy,
+};
+
+const sph_sink_ops sph_png_sink_batch_ops = {
+    .name = "png",
+    .enabled = png_enabled,
+    .distributed = 1,
+    .open = png_open_batch,
     .write = png_write,
     .flush = png_flush,
     .close = png_close,

@@ -26,6 +26,10 @@ extern const sph_sink_ops sph_png_sink_thread_ops;
  * against (tests/unit/test_png_async.c). */
 extern const sph_sink_ops sph_png_sink_sync_ops;
 
+/* The same frames, recorded by `write` and all drawn at `close` with the
+ * run-wide range and camera (sph render: nothing drawn twice). */
+extern const sph_sink_ops sph_png_sink_batch_ops;
+
 /* Checks, before anything is written, that the scene's png block can give
  * a picture: a usable camera, not inside a body (3D), a clip/cut that keeps
  * some particle, and at least one kept initial particle whose centre
@@ -46,6 +50,7 @@ typedef struct sph_mp4_info {
   char path[1100]; /* <dir>/<scene>.mp4 */
   char codec[16];  /* libx264, or mpeg4 when ffmpeg lacks libx264 */
   int frames;
+  double fps;     /* frames per second: the video lasts frames / fps */
   double seconds; /* wall time of ffmpeg */
 } sph_mp4_info;
 

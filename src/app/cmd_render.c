@@ -275,7 +275,7 @@ static sph_status render_frames(render_job *j, int *frames, sph_error *err) {
   sim.dp = sph_scene_min_spacing(s);
   sim.threads = 1;
   SPH_TRY(sph_png_check(&sim, err));
-  sph_sink sink = {.ops = &sph_png_sink_sync_ops};
+  sph_sink sink = {.ops = &sph_png_sink_batch_ops};
   sph_status st = sink.ops->open(&sink, &sim, j->out, err);
   for (int i = 0; st == SPH_OK && i < j->pvd.count; ++i) {
     double t;
@@ -385,8 +385,8 @@ static sph_status render_run(render_args *a, int *frames, sph_error *err) {
     sph_status mst = sph_mp4_assemble(j.out, j.scene->name, *frames,
                                       j.scene->output.png.fps, &info, &merr);
     if (mst == SPH_OK)
-      printf("mp4: %s (%d frames, %s, %.1f s)\n", info.path, info.frames,
-             info.codec, info.seconds);
+      printf("mp4: %s (%d frames, %.1f s at %g fps, %s)\n", info.path,
+             info.frames, info.frames / info.fps, info.fps, info.codec);
     else if (mst == SPH_ERR_UNSUPPORTED)
       printf("mp4 skipped: ffmpeg not found\n");
     else {

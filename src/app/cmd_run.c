@@ -231,8 +231,8 @@ static void print_outputs(const sph_run_report *r, const sph_sim *sim,
            100.0 * SPH_DOMAIN_IMBALANCE, mv.ghosts_max, mv.halo_max);
   const sph_mp4_info *mp4 = &r->mp4;
   if (r->mp4_tried && r->mp4_status == SPH_OK)
-    printf("mp4: %s (%d frames, %s, %.1f s)\n", mp4->path, mp4->frames,
-           mp4->codec, mp4->seconds);
+    printf("mp4: %s (%d frames, %.1f s at %g fps, %s)\n", mp4->path,
+           mp4->frames, mp4->frames / mp4->fps, mp4->fps, mp4->codec);
   else if (r->mp4_tried && r->mp4_status == SPH_ERR_UNSUPPORTED)
     printf("mp4 skipped: ffmpeg not found\n");
   else if (r->mp4_tried) {

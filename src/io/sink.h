@@ -49,6 +49,9 @@ struct sph_sink {
   /* > 0 when resuming: frames 0 .. resume_frames - 1 exist already and the
    * sink continues after them */
   int resume_frames;
+  /* set before close: the run stopped before its end (a signal, a stop
+   * request) and may be resumed, so the sink may keep what a resume needs */
+  int stopping;
   /* wall time spent in its hooks (kept by the caller; summary.json) */
   double seconds;
   /* wall time the sink's own thread spent working, in parallel with the

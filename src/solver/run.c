@@ -475,6 +475,7 @@ static void sinks_close(sph_run *run, sph_run_report *r) {
   for (int i = 0; i < run->nsinks; ++i) {
     sph_sink *s = &run->sinks[i];
     double t0 = sph_wtime();
+    s->stopping = run->stopped != 0 && run->st == SPH_OK;
     if (s->data && !r->io_failed && s->ops->close(s, &cerr) != SPH_OK) {
       r->io_failed = 1;
       run->err = cerr;

@@ -9,8 +9,10 @@ small=(--threads 1 --quiet --set 'bodies.0.particles.count=[3,7,3]' --set time.e
 
 # kept_run STOPPED REFERENCE NAME: what a run stopped by a failure or a
 # signal left: no temporary (.part) file (parts_ok=1: a run killed with
-# SIGKILL may leave them), every frame (.vtp, frames/*.png) identical to the
-# uninterrupted run's, each CSV table a byte prefix of the uninterrupted
+# SIGKILL may leave them), every .vtp identical to the uninterrupted run's
+# and every PNG frame a whole image (their colour range and camera are
+# the stopped run's own, one for all its frames; after --resume they equal
+# the uninterrupted run's, same_run), each CSV table a byte prefix of the uninterrupted
 # one (rows kept, at most a torn last line), the .pvd series read cleanly
 # by VTK's reader. Prints the rows kept.
 kept_run() {
@@ -18,9 +20,14 @@ kept_run() {
   local parts
   parts=$(find "$s" -name '*.part')
   [ -z "$parts" ] || [ "${parts_ok:-0}" = 1 ] || bad "$s: temporary files left: $parts"
-  for f in "$s"/*.vtp "$s"/frames/*.png; do
+  for f in "$s"/*.vtp; do
     [ -e "$f" ] || continue
     cmp -s "$f" "$r/${f#"$s"/}" || bad "$s: ${f#"$s"/} differs from the uninterrupted run's"
+  done
+  for f in "$s"/frames/*.png; do
+    [ -e "$f" ] || continue
+    [ -e "$r/${f#"$s"/}" ] || bad "$s: ${f#"$s"/} is not a frame of the uninterrupted run"
+    "${sph:?}" imgdiff "$f" "$f" >/dev/null 2>&1 || bad "$s: ${f#"$s"/} is not a whole PNG"
   done
   for f in energy.csv probes.csv; do
     [ -f "$r/$f" ] || continue

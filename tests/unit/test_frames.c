@@ -17,6 +17,9 @@
 #define W 320
 #define H 240
 
+/* The spheres' radius: that of the particle's volume, dp = 0.2 m */
+#define R (0.2 * 0.6203504908994)
+
 static char dir[] = "/tmp/sph_frames_XXXXXX";
 
 /* Runs the block scene with extra png keys and velocity; reads frame 1. */
@@ -94,10 +97,10 @@ START_TEST(clip_plane) {
   long na = extent(&whole, &a0, &a1);
   extent(&clipped, &b0, &b1);
   ck_assert_msg(na > 1000 && a1 - a0 > 60, "block: %ld px, %d..%d", na, a0, a1);
-  /* x in [-0.1, 1.1] spans a0..a1; the plane with the kept spheres' radius
-   * (centres 0, 0.2, 0.4) ends at x = 0.5 */
-  double scale = (a1 + 1 - a0) / 1.2;
-  int plane = (int)(a0 + 0.6 * scale + 1.5);
+  /* x in [-R, 1 + R] spans a0..a1; the kept spheres (centres 0, 0.2, 0.4)
+   * end at x = 0.4 + R */
+  double scale = (a1 + 1 - a0) / (1.0 + 2.0 * R);
+  int plane = (int)(a0 + (0.4 + 2.0 * R) * scale + 1.5);
   long beyond = 0;
   for (int y = 0; y < H; ++y)
     for (int x = plane; x < W; ++x)
@@ -120,7 +123,9 @@ END_TEST
 
 START_TEST(cut_half) {
   sph_image whole, cut;
-  const char *oblique = ", camera: {azimuth: 30, elevation: 20, zoom: 0.6}";
+  /* follow: false, so both frames share the initial bodies' fit */
+  const char *oblique =
+      ", camera: {azimuth: 30, elevation: 20, zoom: 0.6, follow: false}";
   render("oblique", oblique, 0.0, &whole);
   char keys[256];
   snprintf(keys, sizeof keys, "%s, cut: half", oblique);
@@ -207,7 +212,7 @@ END_TEST
 
 START_TEST(scale_bar_length) {
   /* the bar is a nice length (1, 2 or 5 x 10^k m) at the frame's scale:
-   * the block's 1.2 m (centres 0..1, spheres 0.1 m each side) spans
+   * the block's 1 + 2 R m (centres 0..1, spheres of radius R) spans
    * a0..a1 in the same front ortho view */
   sph_image plain, bar;
   char keys[256];
@@ -216,7 +221,7 @@ START_TEST(scale_bar_length) {
   render("bar", keys, 0.0, &bar);
   int a0, a1;
   extent(&plain, &a0, &a1);
-  double px_per_m = (a1 + 1 - a0) / 1.2;
+  double px_per_m = (a1 + 1 - a0) / (1.0 + 2.0 * R);
   /* the longest black run of a row in the bottom band */
   int longest = 0;
   for (int y = H - H / 7; y < H; ++y) {
