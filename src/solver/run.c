@@ -317,13 +317,21 @@ static sph_status step_once(sph_run *run, sph_error *err) {
   sph_sim *sim = run->sim;
   double eps = run_eps(run), t_end = run->scene->t_end;
   double next = output_time(run, run->index);
-  SPH_TRY(sph_sim_step(sim, next - sim->t, err));
+  int at_steps = run->hooks.at_steps;
+  SPH_TRY(sph_sim_step(sim, (at_steps ? t_end : next) - sim->t, err));
   run->derived = 0;
   if (run->hooks.step)
     run->hooks.step(run->hooks.ctx, sim->t, sim->steps);
   sph_status st = SPH_OK;
   if (sim->t >= next - eps) {
-    sim->t = next; /* land exactly on the output time */
+    if (!at_steps)
+      sim->t = next; /* land exactly on the output time */
+    else if (sim->t >= t_end - eps)
+      sim->t = t_end;
+    /* at_steps: the output times this step passed write one frame */
+    while (at_steps && run->index + 1 < sph_run_frame_count(run) &&
+           output_time(run, run->index + 1) <= sim->t + eps)
+      run->index++;
     st = output_frame(run, run->index++, err);
     if (run->hooks.output)
       run->hooks.output(run->hooks.ctx, sim->t, sim->steps);

@@ -291,9 +291,12 @@ static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
   SPH_TRY(
       sph_step_leapfrog(sim, &m->ref, &m->lf, m->timer_integration, dt, err));
   /* a particle that crossed a plane in the step trades places with its
-   * image at once */
-  if (m->mirrored && sph_mirror_crossed(sim, &m->ref, m->x) > 0)
+   * image at once; F then in the new reference (f = I to round-off), as an
+   * output frame's derive would make it, which the next stable step reads */
+  if (m->mirrored && sph_mirror_crossed(sim, &m->ref, m->x) > 0) {
     SPH_TRY(reference_update(m, err));
+    SPH_TRY(deformation_and_stress(m, (long)sim->ps->n, err));
+  }
   return SPH_OK;
 }
 
