@@ -317,7 +317,7 @@ static sph_status step_once(sph_run *run, sph_error *err) {
   sph_sim *sim = run->sim;
   double eps = run_eps(run), t_end = run->scene->t_end;
   double next = output_time(run, run->index);
-  int at_steps = run->hooks.at_steps;
+  int at_steps = run->hooks.at_steps || run->scene->output.at_steps;
   SPH_TRY(sph_sim_step(sim, (at_steps ? t_end : next) - sim->t, err));
   run->derived = 0;
   if (run->hooks.step)
@@ -328,13 +328,14 @@ static sph_status step_once(sph_run *run, sph_error *err) {
       sim->t = next; /* land exactly on the output time */
     else if (sim->t >= t_end - eps)
       sim->t = t_end;
-    /* at_steps: the output times this step passed write one frame */
-    while (at_steps && run->index + 1 < sph_run_frame_count(run) &&
-           output_time(run, run->index + 1) <= sim->t + eps)
-      run->index++;
-    st = output_frame(run, run->index++, err);
-    if (run->hooks.output)
-      run->hooks.output(run->hooks.ctx, sim->t, sim->steps);
+    /* at_steps: a frame for every output time this step reached */
+    do {
+      st = output_frame(run, run->index++, err);
+      if (run->hooks.output)
+        run->hooks.output(run->hooks.ctx, sim->t, sim->steps);
+    } while (st == SPH_OK && at_steps &&
+             run->index < sph_run_frame_count(run) &&
+             output_time(run, run->index) <= sim->t + eps);
   }
   if (st == SPH_OK && !run->opt.no_files && sim->t >= run->next_ckpt - eps &&
       sim->t < t_end - eps) {
