@@ -654,6 +654,8 @@ static sph_status load(const char *path, const manifest *m, sph_sim *sim,
  * what the method derives from its state, then counters, time and verdict. */
 static sph_status apply(sph_sim *sim, const loaded *l, sph_verdict *v,
                         int *next_output, sph_error *err) {
+  /* the time first: restore evaluates the rates at it (a moving wall) */
+  sim->t = l->h.t;
   if (sim->method->restore)
     SPH_TRY(sim->method->restore(sim, err));
   /* after restore, which may count a rebuild of its own */
@@ -661,7 +663,6 @@ static sph_status apply(sph_sim *sim, const loaded *l, sph_verdict *v,
     sim->timers[i].calls = (unsigned long)l->calls[i];
   for (int i = 0; i < sim->nterms; ++i)
     sim->terms[i].calls = (unsigned long)l->calls[sim->ntimers + i];
-  sim->t = l->h.t;
   sim->steps = (unsigned long)l->h.steps;
   sim->dt_min = l->h.dt_min;
   sim->dt_max = l->h.dt_max;

@@ -196,6 +196,7 @@ typedef struct sph_output {
   sph_probe *probes;
   size_t nprobes;
   double checkpoint_every; /* 0 = off */
+  int at_steps; /* 1: frames at the steps reaching the output times (run.c) */
 } sph_output;
 
 /* Thresholds of the stability verdict the scene may change (the optional

@@ -73,8 +73,9 @@ sph_status sph_schema_output(sph_scene *s, sph_node *root, sph_error *err) {
   SPH_TRY(sph_node_insert_default(root, "output", "{}", &out, err));
   if (out->kind != SPH_NODE_MAP)
     return sph_node_error(out, err, SPH_ERR_TYPE, "expected a mapping");
-  static const char *const keys[] = {"every",  "fields",           "vtk", "png",
-                                     "probes", "checkpoint_every", NULL};
+  static const char *const keys[] = {"every",    "fields", "vtk",
+                                     "png",      "probes", "checkpoint_every",
+                                     "at_steps", NULL};
   SPH_TRY(sph_node_check_keys(out, keys, err));
   sph_output *o = &s->output;
   SPH_TRY(
@@ -130,6 +131,8 @@ sph_status sph_schema_output(sph_scene *s, sph_node *root, sph_error *err) {
     SPH_TRY(sph_node_get_bool(out, "vtk", 0, 1, &o->vtk, err));
   }
   SPH_TRY(sph_png_schema_parse(&s->output.png, out, err));
+  if (sph_node_child(out, "at_steps")) /* no default: scene_used as given */
+    SPH_TRY(sph_node_get_bool(out, "at_steps", 1, 0, &o->at_steps, err));
   if (sph_node_child(out, "checkpoint_every"))
     SPH_TRY(sph_node_get_positive(out, "checkpoint_every", 1, 0,
                                   &o->checkpoint_every, err));

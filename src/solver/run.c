@@ -324,16 +324,25 @@ static sph_status step_once(sph_run *run, sph_error *err) {
   sph_sim *sim = run->sim;
   double eps = run_eps(run), t_end = run->scene->t_end;
   double next = output_time(run, run->index);
-  SPH_TRY(sph_sim_step(sim, next - sim->t, err));
+  int at_steps = run->hooks.at_steps || run->scene->output.at_steps;
+  SPH_TRY(sph_sim_step(sim, (at_steps ? t_end : next) - sim->t, err));
   run->derived = 0;
   if (run->hooks.step)
     run->hooks.step(run->hooks.ctx, sim->t, sim->steps);
   sph_status st = SPH_OK;
   if (sim->t >= next - eps) {
-    sim->t = next; /* land exactly on the output time */
-    st = output_frame(run, run->index++, err);
-    if (run->hooks.output)
-      run->hooks.output(run->hooks.ctx, sim->t, sim->steps);
+    if (!at_steps)
+      sim->t = next; /* land exactly on the output time */
+    else if (sim->t >= t_end - eps)
+      sim->t = t_end;
+    /* at_steps: a frame for every output time this step reached */
+    do {
+      st = output_frame(run, run->index++, err);
+      if (run->hooks.output)
+        run->hooks.output(run->hooks.ctx, sim->t, sim->steps);
+    } while (st == SPH_OK && at_steps &&
+             run->index < sph_run_frame_count(run) &&
+             output_time(run, run->index) <= sim->t + eps);
   }
   if (st == SPH_OK && !run->opt.no_files && sim->t >= run->next_ckpt - eps &&
       sim->t < t_end - eps) {

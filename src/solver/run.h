@@ -27,6 +27,12 @@ typedef struct sph_run_hooks {
   double every;
   /* 1: go on to the end time after an indicator tripped */
   int keep_going;
+  /* 1: steps independent of the output times (every step its stable
+   * step, the last one landing on the end time), each frame written at the
+   * first step that reaches its output time and stamped with that step's
+   * time, so the trajectory does not depend on the outputs; 0: a step is
+   * shortened to land on each output time (docs/results.md, issue 35) */
+  int at_steps;
   /* the command line recorded in scene_used.yaml and summary.json (NULL:
    * "") */
   const char *command;

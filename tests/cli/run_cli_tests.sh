@@ -185,5 +185,20 @@ got=$(spin_of -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active)
 [ "$got" = "OMP_WAIT_POLICY=active " ] && ok || bad "user's OMP_WAIT_POLICY: '$got'"
 rm -rf "$work/spin"
 
+# output.at_steps: the steps do not depend on the output times, so two
+# output intervals end in the same bytes (issue 35; ul-csph's punch, whose
+# end state moves by a spacing when the steps land on the output times)
+for e in 0.00001 0.00012; do
+  "$sph" run punch_ul_csph --out "$work/at$e" --quiet --set output.png=false \
+    --set output.at_steps=true --set output.every=$e \
+    --set stability.zigzag_max=0 --set stability.fracture_dp=0 >/dev/null 2>&1
+done
+cmp -s "$work/at0.00001/punch_ul_csph_0048.vtp" \
+  "$work/at0.00012/punch_ul_csph_0004.vtp" && ok ||
+  bad "output.at_steps: the end states of two output intervals differ"
+"$sph" check punch_ul_csph --set output.at_steps=3 2>"$work/stderr" >/dev/null
+[ $? -eq 2 ] && grep -q "at_steps" "$work/stderr" && ok ||
+  bad "output.at_steps=3 not refused: $(cat "$work/stderr")"
+
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -211,6 +211,21 @@ void sph_images_assign(sph_ref *ref, size_t g, const sph_mirror_table *t,
  * the composed reflection (sign flips across coordinate planes). */
 void sph_mirror_state(const sph_ref *ref, double *x, double *p, double *F,
                       double *H, double *J);
+/* The particles that start on a symmetry plane stay on it with zero
+ * normal momentum (on a skew-symmetry plane: zero tangential momentum and
+ * displacement), the particles' x and p (each its own image). */
+void sph_mirror_hold(const sph_sim *sim, const sph_ref *ref, double *x,
+                     double *p);
+/* How many of the particles at x lie across a plane from their body (over
+ * every rank; collective). */
+long sph_mirror_crossed(const sph_sim *sim, const sph_ref *ref,
+                        const double *x);
+/* A particle across a plane from its body and the image on its side trade
+ * places (the same points, relabelled): at a reference update (x = X) its
+ * x, X, p, F and F^r are reflected, its images' X with it, and the images'
+ * state is mirrored again. */
+void sph_mirror_fold(const sph_sim *sim, sph_ref *ref, double *x, double *p,
+                     double *F, double *Fr);
 /* Over MPI ranks with mirror images (sync_images): the ghosts' values of
  * `field` (ncomp a point), which the images of ghosts mirror, from their
  * owners; else nothing. */

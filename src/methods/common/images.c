@@ -615,3 +615,129 @@ sph_status sph_mirror_sources(const sph_sim *sim, const sph_ref *ref,
     return SPH_OK;
   return sph_domain_exchange(sim->domain, field, ncomp, err);
 }
+
+/* A particle that starts on a plane is its own image: across a symmetry
+ * plane its normal momentum is zero and it stays on the plane, across a
+ * skew-symmetry plane its tangential momentum and displacement are zero. */
+static void hold_on_plane(const plane *pl, const double *X0, double *x,
+                          double *p) {
+  const double *n = pl->geo.n;
+  double pn = sph_vec3_dot(p, n), xn = sph_plane_distance(&pl->geo, x);
+  double Xn = sph_plane_distance(&pl->geo, X0);
+  for (int c = 0; c < 3; ++c) {
+    if (pl->sigma > 0) { /* symmetry: the normal components */
+      p[c] = pl->geo.axis == c ? 0.0 : p[c] - pn * n[c];
+      x[c] = pl->geo.axis == c ? pl->geo.at : x[c] - xn * n[c];
+    } else { /* skew-symmetry: the tangential components */
+      p[c] = pn * n[c];
+      x[c] = X0[c] + (xn - Xn) * n[c];
+    }
+  }
+}
+
+void sph_mirror_hold(const sph_sim *sim, const sph_ref *ref, double *x,
+                     double *p) {
+  plane planes[32];
+  int oblique, np = scene_planes(sim->scene, planes, &oblique);
+  const sph_particles *ps = sim->ps;
+  const double *X0 = ps->field[SPH_FIELD_POSITION0];
+  double tol = 1e-9 * sim->dp;
+  long n = (long)ref->n;
+  if (!np || !X0)
+    return;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a)
+    for (int k = 0; k < np; ++k) {
+      const plane *pl = &planes[k];
+      if ((pl->body < 0 || ps->body[a] == pl->body) &&
+          fabs(sph_plane_distance(&pl->geo, X0 + 3 * a)) <= tol)
+        hold_on_plane(pl, X0 + 3 * a, x + 3 * a, p + 3 * a);
+    }
+}
+
+/* The planes' sides over every rank (plane_sides): what sph_mirror_crossed
+ * and sph_mirror_fold judge a particle by. */
+static int planes_of(const sph_sim *sim, plane *planes) {
+  int oblique, np = scene_planes(sim->scene, planes, &oblique);
+  plane_sides(planes, np, sim->ps, sim->domain);
+  return np;
+}
+
+/* whether point X lies across plane pl from its body */
+static int across(const plane *pl, const sph_ref *ref, size_t a,
+                  const double *X) {
+  return (pl->body < 0 || ref->body[a] == pl->body) &&
+         sph_plane_distance(&pl->geo, X) * pl->side < 0.0;
+}
+
+long sph_mirror_crossed(const sph_sim *sim, const sph_ref *ref,
+                        const double *x) {
+  plane planes[32];
+  int np = planes_of(sim, planes);
+  long n = (long)ref->n, count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count)
+  for (long a = 0; a < n; ++a)
+    for (int k = 0; k < np; ++k)
+      count += across(&planes[k], ref, (size_t)a, x + 3 * a);
+  return (long)sph_domain_max(sim->domain, (double)count);
+}
+
+/* v -> Q v and A -> I + sigma Q (A - I) Q with Q = I - 2 n n^T */
+static void reflect_vector(const plane *pl, double *v) {
+  double vn = sph_vec3_dot(v, pl->geo.n);
+  for (int c = 0; c < 3; ++c)
+    v[c] -= 2.0 * vn * pl->geo.n[c];
+}
+
+static void reflect_tensor(const plane *pl, double *A) {
+  double Q[9], B[9], T[9];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Q[3 * i + j] = (i == j) - 2.0 * pl->geo.n[i] * pl->geo.n[j];
+      B[3 * i + j] = A[3 * i + j] - (i == j);
+    }
+  sph_mat3_mul(Q, B, T);
+  sph_mat3_mul(T, Q, B);
+  for (int k = 0; k < 9; ++k)
+    A[k] = (k % 4 == 0) + pl->sigma * B[k];
+}
+
+void sph_mirror_fold(const sph_sim *sim, sph_ref *ref, double *x, double *p,
+                     double *F, double *Fr) {
+  plane planes[32];
+  int np = planes_of(sim, planes);
+  long n = (long)ref->n, ne = (long)ref->n_ext, ni = (long)ref->n_img;
+  /* the images first: those of a source that folds fold with it */
+#pragma omp parallel for schedule(static)
+  for (long g = n; g < ni; ++g)
+    for (int k = 0; k < np; ++k) {
+      size_t s = (size_t)ref->src[g];
+      if (across(&planes[k], ref, s, x + 3 * s)) {
+        double *Xg = ref->X + 3 * g;
+        sph_plane_reflect(&planes[k].geo, Xg,
+                          sph_plane_distance(&planes[k].geo, Xg), Xg);
+      }
+    }
+    /* then the owned particles and the ghosts */
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < ne; ++a) {
+    if (a >= n && a < ni)
+      continue;
+    for (int k = 0; k < np; ++k) {
+      const plane *pl = &planes[k];
+      double *xa = x + 3 * a, *Xa = ref->X + 3 * a;
+      if (!across(pl, ref, (size_t)a, xa))
+        continue;
+      sph_plane_reflect(&pl->geo, xa, sph_plane_distance(&pl->geo, xa), xa);
+      sph_plane_reflect(&pl->geo, Xa, sph_plane_distance(&pl->geo, Xa), Xa);
+      reflect_vector(pl, p + 3 * a);
+      if (pl->sigma < 0) /* skew-symmetry: the tangential components */
+        for (int c = 0; c < 3; ++c)
+          p[3 * a + c] = -p[3 * a + c];
+      reflect_tensor(pl, F + 9 * a);
+      reflect_tensor(pl, Fr + 9 * a);
+    }
+  }
+  sph_mirror_state(ref, x, p, F, NULL, NULL);
+  sph_mirror_state(ref, x, p, Fr, NULL, NULL);
+}

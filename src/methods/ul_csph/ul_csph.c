@@ -137,6 +137,7 @@ static sph_status ul_csph_rates(void *ctx, double t, sph_error *err) {
 
 static sph_status ul_csph_constrain(void *ctx, double t, sph_error *err) {
   ul_csph *m = ctx;
+  sph_mirror_hold(m->sim, &m->ref, m->x, m->p);
   return sph_step_constrain_terms(m->sim, &m->ref, t, err);
 }
 
@@ -249,6 +250,8 @@ static sph_status reference_update(ul_csph *m, sph_error *err) {
   SPH_TRY(deformation_and_stress(m, (long)ref->n, err));
   memcpy(ref->X, m->x, 3 * ref->n_ext * sizeof *ref->X);
   memcpy(m->Fr, m->F, 9 * ref->n_ext * sizeof *m->Fr);
+  if (m->mirrored)
+    sph_mirror_fold(sim, ref, m->x, m->p, m->F, m->Fr);
   ul_mirror_store(m);
   sph_status st = rebuild(m, err);
   m->lf.have_rates = 0; /* the rates of the new reference */
@@ -285,7 +288,16 @@ static sph_status ul_csph_step(sph_sim *sim, double dt, sph_error *err) {
   if (m->update_distance > 0.0 ? moved_beyond(m) : m->since >= m->update_every)
     SPH_TRY(reference_update(m, err));
   m->since += 1.0;
-  return sph_step_leapfrog(sim, &m->ref, &m->lf, m->timer_integration, dt, err);
+  SPH_TRY(
+      sph_step_leapfrog(sim, &m->ref, &m->lf, m->timer_integration, dt, err));
+  /* a particle that crossed a plane in the step trades places with its
+   * image at once; F then in the new reference (f = I to round-off), as an
+   * output frame's derive would make it, which the next stable step reads */
+  if (m->mirrored && sph_mirror_crossed(sim, &m->ref, m->x) > 0) {
+    SPH_TRY(reference_update(m, err));
+    SPH_TRY(deformation_and_stress(m, (long)sim->ps->n, err));
+  }
+  return SPH_OK;
 }
 
 static sph_status ul_csph_derive(sph_sim *sim, sph_error *err) {
@@ -413,6 +425,7 @@ static sph_status ul_csph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   SPH_TRY(sph_domain_track(sim->domain, m->ref.X, 3, err));
   SPH_TRY(sph_domain_track(sim->domain, m->Fr, 9, err));
   SPH_TRY(sph_domain_track(sim->domain, m->V0, 1, err));
+  m->mirrored = m->ref.n_img > m->ref.n || m->ref.all_images;
   SPH_TRY(ul_mirror_setup(m, err));
   SPH_TRY(rebuild(m, err));
   return sph_step_leapfrog_attach(sim, &m->ref, &m->lf, m->dp, ul_csph_rates,

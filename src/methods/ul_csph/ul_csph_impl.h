@@ -36,6 +36,7 @@ typedef struct ul_csph {
   /* over MPI ranks with symmetry planes (ul_csph_mirror.c): per particle
    * its images' serial numbers (-1: none) and reference positions (kimg,
    * 3 kimg), per point an image's serial number, the placement's work */
+  int mirrored; /* the scene has symmetry or skew-symmetry planes */
   int kimg;
   double *imgj, *imgX;
   int64_t *gj;
