@@ -3,23 +3,23 @@
 # they are (each image one frame of `sph run SCENE`, with the scene's own
 # settings; punch and coining have no output.png block, so theirs is the
 # default one), and one short animation per headline scene (twisting_column,
-# colliding_rings, punch) as outputs/gallery/SCENE.mp4 (git-ignored: made
-# here, not kept), then checks the sizes. The plots of outputs/gallery
+# colliding_rings, punch) as outputs/gallery/SCENE.mp4 (*.mp4 is git-ignored
+# there: those under 2 MiB are added by hand), then checks the sizes. The plots of outputs/gallery
 # (*_energy, *_convergence, *_error_vs_time) come from studies/, not from here.
 #
 # usage: tools/gallery/make_gallery.sh [--sph PATH] [--threads N] [SCENE]...
 #   default: every scene below, one after another, with build/sph; each run
 #   writes outputs/SCENE/ (replacing it) and prints its wall time.
 set -eu
-cd "$(dirname "$0")/../.."
-sph=build/sph
+root=$(cd "$(dirname "$0")/../.." && pwd)
+sph=$root/build/sph
 threads=()
 scenes=()
 while [ $# -gt 0 ]; do
   case "$1" in
-  --sph) sph=$2; shift 2 ;;
+  --sph) sph=$(realpath "$2"); shift 2 ;;
   --threads) threads=(--threads "$2"); shift 2 ;;
-  -h | --help) sed -n '2,13p' "$0"; exit 0 ;;
+  -h | --help) sed -n '2,12p' "$0"; exit 0 ;;
   *) scenes+=("$1"); shift ;;
   esac
 done
@@ -37,6 +37,7 @@ sets[coining]="--set output.png=true"; frames[coining]="46:coining"
 sets[oring_squeeze]="";             frames[oring_squeeze]="50:oring_squeeze"
 sets[dogbone_tensile]="";           frames[dogbone_tensile]="40:dogbone_tensile"
 mp4[twisting_column]=yes; mp4[colliding_rings]=yes; mp4[punch]=yes
+cd "$root"
 
 png_max=$((1024 * 1024))     # a gallery image stays under 1 MiB
 mp4_max=$((2 * 1024 * 1024)) # an animation over 2 MiB is reported: keep it out of git
