@@ -207,11 +207,23 @@ static sph_status load_csv(reader *R, int *has_z) {
 
 /* ---- .vtp ---------------------------------------------------------------- */
 
+/* vtk_read's error (its file and line apart) as one message naming them */
+static sph_status vtk_error(const reader *R, sph_status st) {
+  if (st == SPH_OK || !R->err || !R->err->file[0])
+    return st;
+  char msg[sizeof R->err->message], file[sizeof R->err->file];
+  int line = R->err->line;
+  snprintf(msg, sizeof msg, "%s", R->err->message);
+  snprintf(file, sizeof file, "%s", R->err->file);
+  return line > 0 ? sph_error_set(R->err, st, "%s:%d: %s", file, line, msg)
+                  : sph_error_set(R->err, st, "%s: %s", file, msg);
+}
+
 static sph_status load_vtp(reader *R) {
   sph_cloud *c = R->c;
   size_t n;
   int has;
-  SPH_TRY(sph_vtp_count(R->path, "volume", &n, &has, R->err));
+  SPH_TRY(vtk_error(R, sph_vtp_count(R->path, "volume", &n, &has, R->err)));
   if (n == 0)
     return fail(R, 0, "no points");
   c->x = malloc(3 * n * sizeof *c->x);
@@ -219,12 +231,12 @@ static sph_status load_vtp(reader *R) {
   if (!c->x || !c->v)
     return sph_error_set(R->err, SPH_ERR_NOMEM, "%s", R->path);
   double t;
-  SPH_TRY(sph_vtp_read(R->path, n, c->x, has ? "volume" : NULL, 1, c->v, &t,
-                       R->err));
+  SPH_TRY(vtk_error(R, sph_vtp_read(R->path, n, c->x, has ? "volume" : NULL, 1,
+                                    c->v, &t, R->err)));
   c->n = n;
   c->has_volume = has;
   int hasj = 0;
-  SPH_TRY(sph_vtp_count(R->path, "J", &n, &hasj, R->err));
+  SPH_TRY(vtk_error(R, sph_vtp_count(R->path, "J", &n, &hasj, R->err)));
   if (has && hasj) { /* a deformed state's volumes: J V0 */
     double *J = malloc(n * sizeof *J);
     if (!J)
@@ -233,7 +245,7 @@ static sph_status load_vtp(reader *R) {
     for (size_t i = 0; st == SPH_OK && i < n; ++i)
       c->v[i] *= J[i];
     free(J);
-    SPH_TRY(st);
+    SPH_TRY(vtk_error(R, st));
   }
   for (size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k)
