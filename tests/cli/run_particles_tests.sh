@@ -7,6 +7,7 @@
 # file:line:col, naming the file (and the CSV's line), nothing written.
 set -u
 sph=$(realpath "$1")
+with_mpi=${2:-0} # 1: sph is built with MPI (the .pvtp of a 2-rank run)
 . "$(dirname "$0")/harness.sh"
 mkdir -p "$work/case/parts"
 cat >"$work/case/box.yaml" <<'YAML'
@@ -68,6 +69,21 @@ for kind in csv vtp; do
     cmp -s "$work/box/$f" "$work/$kind/$f" && ok || bad "$kind: $f differs from the box's"
   done
 done
+# a 2-rank run's .pvtp, its pieces placed by particle_id: the serial run
+if [ "$with_mpi" = 1 ] && command -v mpirun >/dev/null; then
+  mpi=(mpirun --oversubscribe --bind-to none -x OMP_NUM_THREADS=1 -np 2)
+  [ "$(id -u)" -eq 0 ] && mpi+=(--allow-run-as-root)
+  ids='s/body_id, volume\]/body_id, volume, particle_id]/'
+  sed "$ids" "$work/case/box.yaml" >"$work/case/boxid.yaml"
+  sed "$ids; s|parts/box.vtp|$work/r2/cube_0000.pvtp|" "$work/case/vtp.yaml" >"$work/case/pvtp.yaml"
+  "${mpi[@]}" "$sph" run "$work/case/boxid.yaml" --threads 1 --out "$work/r2" --quiet >/dev/null 2>&1 &&
+    "$sph" run "$work/case/boxid.yaml" --out "$work/boxid" --quiet >/dev/null 2>&1 &&
+    "$sph" run "$work/case/pvtp.yaml" --out "$work/pvtp" --quiet >/dev/null 2>"$work/err" ||
+    bad "pvtp runs: $(cat "$work/err")"
+  for f in cube_0000.vtp cube_0002.vtp energy.csv; do
+    cmp -s "$work/boxid/$f" "$work/pvtp/$f" && ok || bad "pvtp: $f differs from the box's"
+  done
+fi
 (cd / && "$sph" check "$work/vtp/scene_used.yaml") >/dev/null 2>"$work/err" && ok ||
   bad "scene_used.yaml: $(cat "$work/err")"
 
