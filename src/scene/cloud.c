@@ -461,6 +461,37 @@ static sph_status nn_median(const reader *R, int dim) {
   return st;
 }
 
+/* ---- lattice steps ------------------------------------------------------- */
+
+/* the file's lattice, if it is one: on each axis the smallest gap between
+ * coordinates, every coordinate a whole number of them from the lowest
+ * (to 1e-6); else step[] stays 0 */
+static sph_status lattice_steps(const reader *R, int dim) {
+  sph_cloud *c = R->c;
+  double *v = malloc(c->n * sizeof *v), step[3] = {0.0, 0.0, 0.0};
+  if (!v)
+    return sph_error_set(R->err, SPH_ERR_NOMEM, "%s", R->path);
+  int lattice = 1;
+  for (int k = 0; k < dim && lattice; ++k) {
+    for (size_t i = 0; i < c->n; ++i)
+      v[i] = c->x[3 * i + k];
+    qsort(v, c->n, sizeof *v, cmp_double);
+    step[k] = INFINITY;
+    for (size_t i = 1; i < c->n; ++i)
+      if (v[i] > v[i - 1])
+        step[k] = fmin(step[k], v[i] - v[i - 1]);
+    lattice = isfinite(step[k]);
+    for (size_t i = 0; i < c->n && lattice; ++i) {
+      double r = (v[i] - v[0]) / step[k];
+      lattice = fabs(r - round(r)) <= 1e-6;
+    }
+  }
+  for (int k = 0; k < 3; ++k)
+    c->step[k] = lattice ? step[k] : 0.0;
+  free(v);
+  return SPH_OK;
+}
+
 /* ---- the file ------------------------------------------------------------ */
 
 static int has_ext(const char *path, const char *ext) {
@@ -503,6 +534,8 @@ sph_status sph_cloud_read(const char *path, int dim, double scale,
   }
   if (st == SPH_OK)
     st = nn_median(&R, dim);
+  if (st == SPH_OK)
+    st = lattice_steps(&R, dim);
   free(R.line);
   if (st != SPH_OK) {
     sph_cloud_destroy(c);

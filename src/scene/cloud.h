@@ -19,6 +19,8 @@ typedef struct sph_cloud {
   int has_volume; /* the file gave them */
   double lo[3], hi[3];
   double nn_median; /* median nearest-neighbour distance (0: one point) */
+  double step[3];   /* a lattice's step per axis (the verdict's checkerboard
+                       parity), 0 when the particles are not on one */
 } sph_cloud;
 
 /* Reads the file at path (.csv/.txt, or .vtp/.pvtp) for a body of dimension

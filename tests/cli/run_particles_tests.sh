@@ -61,13 +61,17 @@ sed '/particles: {spacing/d' "$work/case/csv.yaml" >"$work/case/est.yaml"
   grep -qF "dp estimated: the median nearest-neighbour distance" "$work/out" && ok ||
   bad "estimated spacing: $(cat "$work/out")"
 
-# the same run as the box, bit for bit, from the CSV and from the .vtp
+# the same run as the box, bit for bit, from the CSV and from the .vtp;
+# the same summary (the verdict's indicators), timings apart
+summary() { grep -vE '^ *"(sph|terms|sinks|wall_seconds|render_thread_seconds)"' "$1"; }
 for kind in csv vtp; do
   "$sph" run "$work/case/$kind.yaml" --out "$work/$kind" --quiet >/dev/null 2>"$work/err" ||
     bad "$kind run: $(cat "$work/err")"
   for f in cube_0000.vtp cube_0002.vtp energy.csv; do
     cmp -s "$work/box/$f" "$work/$kind/$f" && ok || bad "$kind: $f differs from the box's"
   done
+  [ "$(summary "$work/box/summary.json")" = "$(summary "$work/$kind/summary.json")" ] && ok ||
+    bad "$kind: summary.json differs from the box's"
 done
 # a 2-rank run's .pvtp, its pieces placed by particle_id: the serial run
 if [ "$with_mpi" = 1 ] && command -v mpirun >/dev/null; then

@@ -137,6 +137,7 @@ START_TEST(test_spacing_is_the_median_distance) {
     ck_assert(!c->has_volume);
     ck_assert(c->nn_median > 0.0);
     ck_assert(c->nn_median == brute_median(c));
+    ck_assert(c->step[0] == 0.0); /* not a lattice: no checkerboard parity */
     sph_cloud_destroy(c);
   }
   unlink(csv_path);
@@ -156,8 +157,13 @@ START_TEST(test_units_and_transform) {
   sph_particles *p = particles_of(2, shape, NULL, NULL);
   sph_particles *t = particles_of(2, shape, "{spacing: 0.01}",
                                   "{rotate: {angle: 90}, translate: [2, 1]}");
-  unlink(csv_path);
   ck_assert_uint_eq(p->n, 12);
+  sph_cloud *c;
+  sph_error err;
+  ck_assert_int_eq(sph_cloud_read(csv_path, 2, 1e-3, &c, &err), SPH_OK);
+  ck_assert_double_eq_tol(c->step[0], 1e-2, 1e-15); /* a lattice's steps */
+  ck_assert_double_eq_tol(c->step[1], 1e-2, 1e-15);
+  sph_cloud_destroy(c);
   ck_assert_uint_eq(t->n, 12);
   for (size_t a = 0; a < p->n; ++a) {
     const double *X = p->field[SPH_FIELD_POSITION0] + 3 * a;
