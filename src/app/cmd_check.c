@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include "app/app_impl.h"
+#include "scene/cloud.h"
 #include "scene/mesh.h"
 #include "scene/node.h"
 #include "scene/polygon.h"
@@ -61,6 +62,15 @@ static void print_plan(const sph_scene *s, sph_sim *sim) {
            s->materials[body->material].ops->name);
     if (body->shape.kind == SPH_SHAPE_MESH)
       print_mesh(body, ps, b);
+    if (body->shape.kind == SPH_SHAPE_PARTICLES)
+      printf("  %-16s particles %s: %zu, total volume %.6g m^%d (%s); dp "
+             "%s\n",
+             "", body->shape.file, body->shape.cloud->n,
+             sph_cloud_volume(body->shape.cloud), s->dimension,
+             body->shape.cloud->has_volume ? "the file's" : "dp^d each",
+             body->shape.spacing_estimated
+                 ? "estimated: the median nearest-neighbour distance"
+                 : "given");
     if (body->shape.kind == SPH_SHAPE_POLYGON) {
       double v = body_volume(ps, b), A = sph_polygon_area(body->shape.polygon);
       printf("  %-16s polygon: area %.6g m^2; particles %.6g m^2, %.2f %% of "

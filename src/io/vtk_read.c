@@ -548,3 +548,67 @@ sph_status sph_vtp_read(const char *path, size_t n, double *points,
   xdoc_destroy(&d);
   return st;
 }
+
+/* A PolyData file's point count and whether it has point array `name`. */
+static sph_status polydata_count(xdoc *d, const char *name, size_t *n,
+                                 int *has) {
+  SPH_TRY(check_root(d, "PolyData"));
+  int poly = child(d, 0, "PolyData", -1);
+  int piece = poly >= 0 ? child(d, poly, "Piece", -1) : -1;
+  unsigned long long count;
+  if (piece < 0)
+    return node_error(d, &d->node[0], "no PolyData piece");
+  if (!parse_count(attr(&d->node[piece], "NumberOfPoints"), &count))
+    return node_error(d, &d->node[piece], "a Piece without NumberOfPoints");
+  *n = (size_t)count;
+  *has = 0;
+  int pdata = child(d, piece, "PointData", -1);
+  for (int i = pdata;
+       name && pdata >= 0 && (i = child(d, pdata, "DataArray", i)) >= 0;)
+    if (attr(&d->node[i], "Name") && !strcmp(attr(&d->node[i], "Name"), name))
+      *has = 1;
+  return SPH_OK;
+}
+
+sph_status sph_vtp_count(const char *path, const char *name, size_t *n,
+                         int *has, sph_error *err) {
+  xdoc d;
+  *n = 0;
+  *has = 0;
+  SPH_TRY(xdoc_load(&d, path, err));
+  const char *type = attr(&d.node[0], "type");
+  sph_status st = SPH_OK;
+  if (!strcmp(d.node[0].name, "VTKFile") && type &&
+      !strcmp(type, "PPolyData")) {
+    int pp = child(&d, 0, "PPolyData", -1), all = 1;
+    if (pp < 0)
+      st = node_error(&d, &d.node[0], "no <PPolyData>");
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash - path) : 0;
+    for (int i = pp; st == SPH_OK && (i = child(&d, pp, "Piece", i)) >= 0;) {
+      const char *src = attr(&d.node[i], "Source");
+      char piece[1400];
+      if (!src || !*src) {
+        st = node_error(&d, &d.node[i], "a Piece without Source");
+        break;
+      }
+      snprintf(piece, sizeof piece, "%.*s%s%s", dirlen, path,
+               slash && src[0] != '/' ? "/" : "", src);
+      xdoc pd;
+      size_t k = 0;
+      int h = 0;
+      st = xdoc_load(&pd, slash && src[0] != '/' ? piece : src, err);
+      if (st == SPH_OK) {
+        st = polydata_count(&pd, name, &k, &h);
+        xdoc_destroy(&pd);
+      }
+      *n += k;
+      all = all && h;
+    }
+    *has = all && *n > 0;
+  } else {
+    st = polydata_count(&d, name, n, has);
+  }
+  xdoc_destroy(&d);
+  return st;
+}

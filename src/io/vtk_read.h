@@ -35,4 +35,9 @@ sph_status sph_vtp_read(const char *path, size_t n, double *points,
                         const char *name, int ncomp, double *values,
                         double *time, sph_error *err);
 
+/* The number of points of a .vtp (or a .pvtp's pieces together) and
+ * whether it (every piece) has the point array `name`; errors as above. */
+sph_status sph_vtp_count(const char *path, const char *name, size_t *n,
+                         int *has, sph_error *err);
+
 #endif

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/cloud.h"
 #include "scene/geometry_impl.h"
 #include "scene/mesh.h"
 #include "scene/polygon.h"
@@ -77,6 +78,8 @@ double sph_shape_distance(const sph_shape *s, int dim, const double X[3]) {
     return sph_mesh_inside(s->mesh, X) ? -1.0 : 1.0;
   case SPH_SHAPE_POLYGON:
     return sph_polygon_inside(s->polygon, X) ? -1.0 : 1.0;
+  case SPH_SHAPE_PARTICLES: /* never asked: the particles are not moved */
+    return -1.0;
   }
   return INFINITY;
 }
@@ -85,7 +88,7 @@ void sph_shape_bounds(const sph_shape *s, int dim, double lo[3], double hi[3]) {
   for (int c = 0; c < 3; ++c)
     lo[c] = hi[c] = 0.0;
   if (s->kind == SPH_SHAPE_BOX || s->kind == SPH_SHAPE_MESH ||
-      s->kind == SPH_SHAPE_POLYGON) {
+      s->kind == SPH_SHAPE_POLYGON || s->kind == SPH_SHAPE_PARTICLES) {
     for (int c = 0; c < dim; ++c) {
       lo[c] = s->min[c];
       hi[c] = s->max[c];
@@ -137,6 +140,8 @@ double sph_shape_measure(const sph_shape *s, int dim) {
     return sph_mesh_get_info(s->mesh)->volume;
   case SPH_SHAPE_POLYGON:
     return sph_polygon_area(s->polygon);
+  case SPH_SHAPE_PARTICLES:
+    return sph_cloud_volume(s->cloud);
   }
   return 0.0;
 }
@@ -317,9 +322,10 @@ static void jitter(lattice *L, double X[3]) {
 /* ---- bodies -------------------------------------------------------------- */
 
 static const char *shape_name(sph_shape_kind kind) {
-  static const char *const names[] = {"box",    "cylinder", "ring", "disc",
-                                      "sphere", "shell",    "mesh", "polygon"};
-  return (int)kind >= 0 && kind <= SPH_SHAPE_POLYGON ? names[kind] : "shape";
+  static const char *const names[] = {"box",  "cylinder", "ring",
+                                      "disc", "sphere",   "shell",
+                                      "mesh", "polygon",  "particles"};
+  return (int)kind >= 0 && kind <= SPH_SHAPE_PARTICLES ? names[kind] : "shape";
 }
 
 static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
@@ -348,7 +354,8 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          "positive length, got %g",
                          b->name, s->length);
   if ((s->kind == SPH_SHAPE_MESH && !s->mesh) ||
-      (s->kind == SPH_SHAPE_POLYGON && !s->polygon))
+      (s->kind == SPH_SHAPE_POLYGON && !s->polygon) ||
+      (s->kind == SPH_SHAPE_PARTICLES && !s->cloud))
     return sph_error_set(err, SPH_ERR_GEOMETRY, "body '%s': no %s", b->name,
                          name);
   if (dim == 3 && s->kind == SPH_SHAPE_POLYGON)
@@ -357,6 +364,13 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
                          "mesh",
                          b->name);
   switch (s->kind) {
+  case SPH_SHAPE_PARTICLES:
+    if (b->lattice == SPH_LATTICE_FACES || b->distribution != SPH_DIST_LATTICE)
+      return sph_error_set(err, SPH_ERR_GEOMETRY,
+                           "body '%s': particles from a file take no count "
+                           "and are not moved",
+                           b->name);
+    break;
   case SPH_SHAPE_MESH: /* its bounding box */
   case SPH_SHAPE_POLYGON:
   case SPH_SHAPE_BOX:
@@ -418,10 +432,22 @@ static sph_status check_body(const sph_body *b, int dim, sph_error *err) {
   return SPH_OK;
 }
 
+/* a particle file's body: its particles in the file's order */
+static sph_status visit_cloud(const sph_cloud *c, sph_point_fn fn, void *ctx,
+                              size_t *n, sph_error *err) {
+  for (size_t i = 0; i < c->n; ++i) {
+    SPH_TRY(fn(ctx, c->x + 3 * i, c->v[i], err));
+    ++*n;
+  }
+  return SPH_OK;
+}
+
 sph_status sph_body_visit(const sph_body *b, int dim, sph_point_fn fn,
                           void *ctx, size_t *n, sph_error *err) {
   *n = 0;
   SPH_TRY(check_body(b, dim, err));
+  if (b->shape.kind == SPH_SHAPE_PARTICLES)
+    return visit_cloud(b->shape.cloud, fn, ctx, n, err);
   lattice L = {.b = b,
                .dim = dim,
                .faces = b->lattice == SPH_LATTICE_FACES,

@@ -89,6 +89,7 @@ static int shape_walls(const sph_shape *s, int dim, const double X[3],
   }
   case SPH_SHAPE_MESH: /* not relaxed (the scene refuses it) */
   case SPH_SHAPE_POLYGON:
+  case SPH_SHAPE_PARTICLES:
     return 0;
   }
   return 0;

@@ -29,12 +29,15 @@ typedef enum sph_shape_kind {
   SPH_SHAPE_SHELL,    /* 3D spherical shell: center, inner/outer radius */
   SPH_SHAPE_MESH,     /* 3D: a closed triangle surface read from a file
                          (scene/mesh.h); min, max its bounding box */
-  SPH_SHAPE_POLYGON   /* 2D: an outline with holes (scene/polygon.h); min,
+  SPH_SHAPE_POLYGON,  /* 2D: an outline with holes (scene/polygon.h); min,
                          max its bounding box */
+  SPH_SHAPE_PARTICLES /* 2D or 3D: particles read from a file
+                         (scene/cloud.h); min, max their bounding box */
 } sph_shape_kind;
 
 struct sph_mesh;    /* see mesh.h */
 struct sph_polygon; /* see polygon.h */
+struct sph_cloud;   /* see cloud.h */
 
 typedef struct sph_shape {
   sph_shape_kind kind;
@@ -44,7 +47,11 @@ typedef struct sph_shape {
   double radius, inner_radius, outer_radius, length;
   struct sph_mesh *mesh;       /* owned by the scene */
   struct sph_polygon *polygon; /* owned by the scene */
-  char file[256];              /* the mesh file as the scene names it */
+  struct sph_cloud *cloud;     /* owned by the scene */
+  int spacing_estimated;       /* a cloud's dp: its median nearest-neighbour
+                                  distance (no `particles: {spacing}`) */
+  char file[256]; /* the mesh, outline or particle file as the scene names
+                     it */
 } sph_shape;
 
 typedef enum sph_lattice {

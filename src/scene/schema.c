@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "scene/cloud.h"
 #include "scene/expr.h"
 #include "scene/mesh.h"
 #include "scene/polygon.h"
@@ -310,6 +311,7 @@ void sph_scene_destroy(sph_scene *s) {
       sph_expr_destroy(s->bodies[i].velocity.expr[c]);
     sph_mesh_destroy(s->bodies[i].shape.mesh);
     sph_polygon_destroy(s->bodies[i].shape.polygon);
+    sph_cloud_destroy(s->bodies[i].shape.cloud);
   }
   free(s->bodies);
   free(s->materials);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/cloud.h"
 #include "scene/expr.h"
 #include "scene/mesh.h"
 #include "scene/outline_read.h"
@@ -229,20 +230,53 @@ static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
   return SPH_OK;
 }
 
+/* particles: {file, units}: positions and optional volumes from a CSV or a
+ * .vtp (cloud.c) */
+static sph_status parse_cloud(sph_scene *s, sph_shape *sh, sph_node *g,
+                              sph_error *err) {
+  static const char *const keys[] = {"file", "units", NULL};
+  SPH_TRY(sph_node_check_keys(g, keys, err));
+  const char *file;
+  int u;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  sph_node *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
+  if (!file[0] || strlen(file) >= sizeof sh->file)
+    return sph_node_error(fn, err, SPH_ERR_RANGE,
+                          "give the particle file's name (under %zu bytes)",
+                          sizeof sh->file);
+  snprintf(sh->file, sizeof sh->file, "%s", file);
+  char path[1024];
+  sph_schema_file_path(fn, file, path, sizeof path);
+  sph_status st =
+      sph_cloud_read(path, s->dimension, sph_length_scale[u], &sh->cloud, err);
+  if (st != SPH_OK) {
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sph_node_error(fn, err, st, "particles %s", msg);
+  }
+  sph_schema_name_absolute(fn, path);
+  for (int c = 0; c < 3; ++c) {
+    sh->min[c] = sh->cloud->lo[c];
+    sh->max[c] = sh->cloud->hi[c];
+  }
+  return SPH_OK;
+}
+
 static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
                               sph_error *err) {
-  static const char *const kinds[] = {"box",     "cylinder", "ring", "disc",
-                                      "sphere",  "shell",    "mesh", "polygon",
-                                      "outline", NULL};
+  static const char *const kinds[] = {"box",     "cylinder",  "ring", "disc",
+                                      "sphere",  "shell",     "mesh", "polygon",
+                                      "outline", "particles", NULL};
   if (n->kind != SPH_NODE_MAP)
     return sph_node_error(n, err, SPH_ERR_TYPE, "expected a mapping");
   SPH_TRY(sph_node_check_keys(n, kinds, err));
   int which;
   SPH_TRY(sph_schema_one_of(n, kinds, "shape", &which, err));
   static const sph_shape_kind map[] = {
-      SPH_SHAPE_BOX,  SPH_SHAPE_CYLINDER, SPH_SHAPE_RING,
-      SPH_SHAPE_DISC, SPH_SHAPE_SPHERE,   SPH_SHAPE_SHELL,
-      SPH_SHAPE_MESH, SPH_SHAPE_POLYGON,  SPH_SHAPE_POLYGON};
+      SPH_SHAPE_BOX,     SPH_SHAPE_CYLINDER, SPH_SHAPE_RING, SPH_SHAPE_DISC,
+      SPH_SHAPE_SPHERE,  SPH_SHAPE_SHELL,    SPH_SHAPE_MESH, SPH_SHAPE_POLYGON,
+      SPH_SHAPE_POLYGON, SPH_SHAPE_PARTICLES};
   memset(sh, 0, sizeof *sh);
   sh->kind = map[which];
   sph_node *g;
@@ -254,6 +288,8 @@ static sph_status parse_shape(sph_scene *s, sph_shape *sh, sph_node *n,
   case SPH_SHAPE_POLYGON:
     return which == 8 ? parse_outline(s, sh, g, err)
                       : parse_polygon(s, sh, g, err);
+  case SPH_SHAPE_PARTICLES:
+    return parse_cloud(s, sh, g, err);
   case SPH_SHAPE_BOX: {
     static const char *const keys[] = {"min", "max", NULL};
     SPH_TRY(sph_node_check_keys(g, keys, err));
@@ -527,6 +563,36 @@ static sph_status parse_transform(sph_scene *s, sph_transform *T, sph_node *n,
   return SPH_OK;
 }
 
+/* a particle file's body: its spacing given (`particles: {spacing}`) or
+ * estimated, the volumes of a file without them dp^d; no count, no jitter */
+static sph_status cloud_spacing(sph_scene *s, sph_body *b, sph_node *shape,
+                                sph_node *parts, sph_error *err) {
+  sph_shape *sh = &b->shape;
+  sph_node *sp = parts ? sph_node_child(parts, "spacing") : NULL;
+  if (parts && sph_node_child(parts, "count"))
+    return sph_node_error(sph_node_child(parts, "count"), err, SPH_ERR_ARG,
+                          "the particles come from %s: give a spacing, or "
+                          "none (it is estimated)",
+                          sh->file);
+  if (parts && b->distribution != SPH_DIST_LATTICE)
+    return sph_node_error(sph_node_child(parts, "distribution"), err,
+                          SPH_ERR_ARG,
+                          "the particles come from %s: they are not moved "
+                          "(distribution: lattice)",
+                          sh->file);
+  b->lattice = SPH_LATTICE_CELL_CENTRED;
+  sh->spacing_estimated = !sp;
+  if (!sp)
+    b->spacing = sh->cloud->nn_median;
+  if (!(b->spacing > 0.0))
+    return sph_node_error(shape, err, SPH_ERR_ARG,
+                          "%s holds one particle: its spacing cannot be "
+                          "estimated; give particles: {spacing: ...}",
+                          sh->file);
+  sph_cloud_set_volumes(sh->cloud, s->dimension, b->spacing);
+  return SPH_OK;
+}
+
 sph_status sph_schema_bodies(sph_scene *s, sph_node *root, sph_error *err) {
   sph_node *list;
   SPH_TRY(sph_schema_get_seq(root, "bodies", 1, &list, err));
@@ -576,8 +642,12 @@ sph_status sph_schema_bodies(sph_scene *s, sph_node *root, sph_error *err) {
     sph_node *shape, *parts, *vel;
     SPH_TRY(sph_node_get_map(n, "shape", 1, &shape, err));
     SPH_TRY(parse_shape(s, &b->shape, shape, err));
-    SPH_TRY(sph_node_get_map(n, "particles", 1, &parts, err));
-    SPH_TRY(parse_particles(s, b, parts, err));
+    int file = b->shape.kind == SPH_SHAPE_PARTICLES;
+    SPH_TRY(sph_node_get_map(n, "particles", !file, &parts, err));
+    if (parts)
+      SPH_TRY(parse_particles(s, b, parts, err));
+    if (file)
+      SPH_TRY(cloud_spacing(s, b, shape, parts, err));
     SPH_TRY(sph_node_get_map(n, "initial_velocity", 0, &vel, err));
     if (vel)
       SPH_TRY(parse_velocity(s, &b->velocity, vel, err));

@@ -7,6 +7,7 @@
 #include "core/tensor.h"
 #include "gpu/gpu.h"
 #include "parallel/domain.h"
+#include "scene/cloud.h"
 #include "scene/geometry.h"
 #include "scene/node.h"
 #include "solver/memory.h"
@@ -116,6 +117,10 @@ static sph_status check_memory(const sph_scene *scene, double support,
   for (size_t b = 0; b < scene->nbodies; ++b) {
     const sph_body *bd = &scene->bodies[b];
     double lo[3], hi[3], k = 1.0;
+    if (bd->shape.kind == SPH_SHAPE_PARTICLES) { /* read: known */
+      n += (double)bd->shape.cloud->n;
+      continue;
+    }
     sph_shape_bounds(&bd->shape, dim, lo, hi);
     for (int c = 0; c < dim; ++c)
       k *= bd->lattice == SPH_LATTICE_FACES

@@ -7,6 +7,7 @@
 #include "core/tensor.h"
 #include "materials/material.h"
 #include "parallel/domain.h"
+#include "scene/cloud.h"
 #include "scene/geometry.h"
 
 #include <math.h>
@@ -62,16 +63,20 @@ void sph_lattice_parity(const sph_scene *s, const sph_particles *ps,
     double X[3];
     sph_body_local(b, ps->field[SPH_FIELD_POSITION0] + 3 * a, X);
     parity[a] = 0;
-    if (b->distribution == SPH_DIST_RELAX)
+    /* a particle file: its own lattice, when it is on one */
+    const double *step =
+        b->shape.kind == SPH_SHAPE_PARTICLES ? b->shape.cloud->step : NULL;
+    if (b->distribution == SPH_DIST_RELAX || (step && !(step[0] > 0.0)))
       continue;
     double lo[3], hi[3];
     sph_shape_bounds(&b->shape, s->dimension, lo, hi);
     long sum = 0;
     for (int c = 0; c < s->dimension; ++c) {
-      double h = b->lattice == SPH_LATTICE_FACES
+      double h = step ? step[c]
+                 : b->lattice == SPH_LATTICE_FACES
                      ? (hi[c] - lo[c]) / (b->count[c] - 1)
                      : b->spacing;
-      double off = b->lattice == SPH_LATTICE_FACES ? 0.0 : 0.5;
+      double off = step || b->lattice == SPH_LATTICE_FACES ? 0.0 : 0.5;
       sum += lround((X[c] - lo[c]) / h - off);
     }
     parity[a] = (sum % 2) ? -1 : 1;

@@ -170,6 +170,7 @@ static double offset_measure(const sph_shape *s, int dim, double grow) {
   case SPH_SHAPE_BOX:
   case SPH_SHAPE_MESH: /* test_mesh.c */
   case SPH_SHAPE_POLYGON:
+  case SPH_SHAPE_PARTICLES: /* test_cloud.c */
     break;
   }
   return NAN;
