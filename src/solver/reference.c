@@ -173,7 +173,10 @@ static sph_status swinging_plate_create(sph_reference *r, const sph_scene *s,
   static const char *const keys[] = {"analytic", "U", "norm", NULL};
   static const char *const norms[] = {"nodal", "gauss", NULL};
   SPH_TRY(sph_node_check_keys(n, keys, err));
-  SPH_TRY(sph_node_get_choice(n, "norm", norms, "nodal", &r->gauss, err));
+  /* absent: nodal, left out of the resolved scene (scene_used.yaml as
+   * before the option) */
+  if (sph_node_child(n, "norm"))
+    SPH_TRY(sph_node_get_choice(n, "norm", norms, "nodal", &r->gauss, err));
   if (s->dimension != 2 || s->nbodies != 1)
     return sph_node_error(n, err, SPH_ERR_ARG,
                           "swinging_plate needs one body in 2D");
