@@ -10,7 +10,7 @@
 
 #define STUDY_MAX_KEYS 8
 #define STUDY_MAX_VALUES 64
-#define STUDY_NORMS 5
+#define STUDY_NORMS 7
 
 extern const char *const study_norm_names[STUDY_NORMS];
 

@@ -15,8 +15,9 @@
 #include "io/sink.h"
 
 const char *const study_norm_names[STUDY_NORMS] = {
-    "l2_velocity", "l2_stress", "l2_displacement", "h1_displacement",
-    "period_error"};
+    "l2_velocity",          "l2_stress",    "l2_displacement",
+    "h1_displacement",      "period_error", "l2_displacement_gauss",
+    "h1_displacement_gauss"};
 
 static const char *const fixed_columns[] = {"particles",
                                             "dp",
@@ -28,6 +29,8 @@ static const char *const fixed_columns[] = {"particles",
                                             "l2_displacement",
                                             "h1_displacement",
                                             "period_error",
+                                            "l2_displacement_gauss",
+                                            "h1_displacement_gauss",
                                             "period",
                                             "energy_drift",
                                             "linear_momentum_drift",
@@ -35,7 +38,7 @@ static const char *const fixed_columns[] = {"particles",
                                             "stable",
                                             "reason",
                                             NULL};
-#define NFIXED 16
+#define NFIXED 18
 
 static void csv_field(FILE *f, const char *s) {
   if (!strpbrk(s, ",\"\n")) {

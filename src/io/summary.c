@@ -191,6 +191,13 @@ static void write_reference_error(FILE *f, const sph_reference_error *ref) {
     json_number(f, q[k].x);
     sep = ", ";
   }
+  /* the paper's norms beside the nodal ones (reference norm: gauss) */
+  if (!isnan(e.l2_displacement_gauss)) {
+    fputs(", \"l2_displacement_gauss\": ", f);
+    json_number(f, e.l2_displacement_gauss);
+    fputs(", \"h1_displacement_gauss\": ", f);
+    json_number(f, e.h1_displacement_gauss);
+  }
   fputs("}", f);
 }
 

@@ -20,6 +20,7 @@
 
 #include "core/tensor.h"
 #include "parallel/domain.h"
+#include "solver/reference_gauss.h"
 
 typedef enum { REF_SWINGING_CUBE, REF_SWINGING_PLATE, REF_PERIOD } ref_kind;
 
@@ -43,6 +44,9 @@ struct sph_reference {
   double lambda, mu;   /* small strain moduli of the body */
   double P_amp, v_amp; /* normalisations */
   int from_rest;       /* u = U0 sin(w t) f: zero displacement at t = 0 */
+  int gauss;           /* norm: gauss, seed 004 eq. 44-45 beside the nodal */
+  sph_gauss_norm *gn;  /* its particle table (rank 0), made at set-up */
+  double t_exact;      /* the time the Gauss norm's exact field is taken at */
 };
 
 /* a mode of amplitudes A at U0 = 1: f_i = A_i f_i(X), G_ij = d f_i / d X_j */
@@ -166,8 +170,13 @@ static sph_status swinging_cube_create(sph_reference *r, const sph_scene *s,
  * w = (pi / 2) sqrt(2 mu / rho) */
 static sph_status swinging_plate_create(sph_reference *r, const sph_scene *s,
                                         sph_node *n, sph_error *err) {
-  static const char *const keys[] = {"analytic", "U", NULL};
+  static const char *const keys[] = {"analytic", "U", "norm", NULL};
+  static const char *const norms[] = {"nodal", "gauss", NULL};
   SPH_TRY(sph_node_check_keys(n, keys, err));
+  /* absent: nodal, left out of the resolved scene (scene_used.yaml as
+   * before the option) */
+  if (sph_node_child(n, "norm"))
+    SPH_TRY(sph_node_get_choice(n, "norm", norms, "nodal", &r->gauss, err));
   if (s->dimension != 2 || s->nbodies != 1)
     return sph_node_error(n, err, SPH_ERR_ARG,
                           "swinging_plate needs one body in 2D");
@@ -224,7 +233,24 @@ sph_status sph_reference_create(sph_reference **out, const sph_scene *s,
   return SPH_OK;
 }
 
-void sph_reference_destroy(sph_reference *r) { free(r); }
+void sph_reference_destroy(sph_reference *r) {
+  if (r)
+    sph_gauss_norm_destroy(r->gn);
+  free(r);
+}
+
+/* the Gauss norm's table on rank 0: one row a particle in storage order
+ * (seed 004: 10 x 10 tiles of [0, 2]^2, 5 x 5 points each) */
+static sph_status gauss_create(sph_reference *r, const sph_sim *sim,
+                               sph_error *err) {
+  sph_status st = SPH_OK;
+  if (sph_domain_rank(sim->domain) == 0) {
+    const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {2.0, 2.0, 0.0};
+    size_t N = sph_domain_particles(sim->domain, sim->ps);
+    st = sph_gauss_norm_create(&r->gn, &sim->kernel, lo, hi, 10, 5, N, err);
+  }
+  return sph_domain_agree(sim->domain, st, err);
+}
 
 sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
                                     sph_error *err) {
@@ -292,6 +318,8 @@ sph_status sph_reference_initialise(const sph_reference *r, sph_sim *sim,
   SPH_TRY(sph_domain_agree(sim->domain, st, err));
   rw->P_amp = sph_domain_max(sim->domain, rw->P_amp);
   sim->initial_defgrad = 1;
+  if (r->gauss && !r->gn)
+    SPH_TRY(gauss_create(rw, sim, err));
   return SPH_OK;
 }
 
@@ -377,6 +405,14 @@ static void error_add(const sph_reference *r, double t, const double *row,
   s[0] += V;
 }
 
+/* the exact displacement and its gradient for the Gauss norm */
+static void gauss_exact(const void *ctx, const double X[3], double u[3],
+                        double G[9]) {
+  const sph_reference *r = ctx;
+  double v[3];
+  exact(r, X, r->t_exact, u, v, G);
+}
+
 typedef struct {
   int64_t key;
   size_t a;
@@ -419,8 +455,16 @@ static sph_status error_sums(const sph_reference *r, const sph_sim *sim,
     }
     st = sph_domain_gather_range(d, keys, rows, k, ROW_W, (int64_t)lo, m, got,
                                  err);
-    for (size_t i = 0; st == SPH_OK && root && i < m; ++i)
-      error_add(r, sim->t, got + (size_t)ROW_W * i, s);
+    for (size_t i = 0; st == SPH_OK && root && i < m; ++i) {
+      const double *row = got + (size_t)ROW_W * i;
+      error_add(r, sim->t, row, s);
+      if (r->gn) {
+        double *gr = sph_gauss_norm_table(r->gn) + SPH_GAUSS_ROW * (lo + i);
+        memcpy(gr + SPH_GAUSS_X, row + ROW_X, 3 * sizeof *gr);
+        gr[SPH_GAUSS_V] = row[ROW_V];
+        memcpy(gr + SPH_GAUSS_U, row + ROW_U, 3 * sizeof *gr);
+      }
+    }
   }
   free(order);
   free(keys);
@@ -434,6 +478,7 @@ sph_status sph_reference_errors(const sph_reference *r, const sph_sim *sim,
   e->l2_velocity = e->l2_stress = e->l2_displacement = e->h1_displacement = NAN;
   e->period = e->period_value = e->period_error = NAN;
   e->period_tolerance = r->tolerance;
+  e->l2_displacement_gauss = e->h1_displacement_gauss = NAN;
   if (r->kind == REF_PERIOD) {
     /* mean period over the half periods between the first and last
      * crossings */
@@ -451,5 +496,14 @@ sph_status sph_reference_errors(const sph_reference *r, const sph_sim *sim,
   e->l2_stress = sqrt(s[2] / s[0]) / r->P_amp;
   e->l2_displacement = sqrt(s[3] / s[0]) / r->U0;
   e->h1_displacement = sqrt(s[4] / s[0]) / (r->U0 * M_PI / 2.0);
+  if (!r->gn) /* nodal, or not rank 0 */
+    return SPH_OK;
+  double g[2];
+  sph_reference *rw = (sph_reference *)r; /* the time the exact field has */
+  rw->t_exact = sim->t;
+  sph_gauss_norm_bin(r->gn);
+  SPH_TRY(sph_gauss_norm_errors(r->gn, gauss_exact, r, g, err));
+  e->l2_displacement_gauss = g[0];
+  e->h1_displacement_gauss = g[1];
   return SPH_OK;
 }

@@ -26,8 +26,8 @@ rc=$?
 check "study exit $rc: $(cat "$work/stderr")" '[ $rc -eq 0 ]'
 csv=$out/results.csv
 check "results.csv has a header and 4 rows" '[ "$(wc -l <"$csv")" -eq 5 ]'
-check "18 columns" '[ "$(ncols "$csv" 1)" -eq 18 ] && [ "$(ncols "$csv" 5)" -eq 18 ]'
-check "header" 'head -1 "$csv" | grep -q "^method.fields,bodies.0.particles.spacing,particles,dp,steps,wall_seconds,particle_steps_per_second,l2_velocity,l2_stress,l2_displacement,h1_displacement,period_error,period,energy_drift,linear_momentum_drift,angular_momentum_drift,stable,reason$"'
+check "20 columns" '[ "$(ncols "$csv" 1)" -eq 20 ] && [ "$(ncols "$csv" 5)" -eq 20 ]'
+check "header" 'head -1 "$csv" | grep -q "^method.fields,bodies.0.particles.spacing,particles,dp,steps,wall_seconds,particle_steps_per_second,l2_velocity,l2_stress,l2_displacement,h1_displacement,period_error,l2_displacement_gauss,h1_displacement_gauss,period,energy_drift,linear_momentum_drift,angular_momentum_drift,stable,reason$"'
 check "rows in case order" '[ "$(cut -d, -f1,2 "$csv" | tail -4 | tr "\n" " ")" = "pF,0.25 pF,0.125 pFJ,0.25 pFJ,0.125 " ]'
 check "particles 64 and 512" '[ "$(field "$csv" 0 particles)" = 64 ] && [ "$(field "$csv" 1 particles)" = 512 ]'
 check "l2_velocity filled" 'python3 -c "import sys; assert 0 < float(sys.argv[1]) < 1" "$(field "$csv" 1 l2_velocity)"'

@@ -6,7 +6,10 @@
 # gathered set, so summary.json gives the serial period, error and verdict,
 # and the files are the serial ones (check_mpi.py: fields and probes
 # identical, energies to 1e-12). The analytic references (they set the
-# initial state) run over ranks too: run_mpi_symmetry.sh (the swinging cube).
+# initial state) run over ranks too: run_mpi_symmetry.sh (the swinging cube);
+# here the swinging plate at d = 0.1 with `norm: gauss`: rank 0 gathers the
+# particles for seed 004's Gauss-point norms, which come out with the serial
+# bits, as do the nodal errors beside them.
 # Usage: run_mpi_reference.sh SPH SOURCE_DIR
 set -u
 sph=$1
@@ -25,4 +28,15 @@ same_verdict() {
 }
 check "plate np 2: the serial period and verdict" same_verdict
 verdict "$work/plate.np2"
+gauss=(run swinging_plate_2d --quiet --set reference.norm=gauss
+  --set output.png=false --set output.vtk=false
+  --set bodies.0.particles.spacing=0.1)
+same_gauss() {
+  "$sph" "${gauss[@]}" --threads 1 --out "$work/gauss.serial" &&
+    "${mpi[@]}" -np 2 "$sph" "${gauss[@]}" --out "$work/gauss.np2" &&
+    verdict "$work/gauss.serial" | grep -q '"l2_displacement_gauss": 0\.000' &&
+    [ "$(verdict "$work/gauss.serial")" = "$(verdict "$work/gauss.np2")" ]
+}
+check "swinging plate np 2: the serial Gauss-point and nodal errors" same_gauss
+verdict "$work/gauss.np2"
 summary
