@@ -38,6 +38,32 @@ const char *const sph_length_units[] = {"m",  "cm", "mm", "um",
                                         "in", "ft", NULL};
 const double sph_length_scale[] = {1.0, 1e-2, 1e-3, 1e-6, 0.0254, 0.3048};
 
+/* a shape's {file, units}: the name kept in sh->file, the path to open
+ * (relative to the scene's folder) and the unit's index */
+static sph_status shape_file(sph_shape *sh, sph_node *g, const char *what,
+                             char *path, size_t size, int *u, sph_node **fn,
+                             sph_error *err) {
+  const char *file;
+  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
+  *fn = sph_node_child(g, "file");
+  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", u, err));
+  if (!file[0] || strlen(file) >= sizeof sh->file)
+    return sph_node_error(*fn, err, SPH_ERR_RANGE,
+                          "give the %s file's name (under %zu bytes)", what,
+                          sizeof sh->file);
+  snprintf(sh->file, sizeof sh->file, "%s", file);
+  sph_schema_file_path(*fn, file, path, size);
+  return SPH_OK;
+}
+
+/* a reader's error ("path: why") placed at the file key, after the shape */
+static sph_status shape_file_error(sph_node *fn, const char *what,
+                                   sph_status st, sph_error *err) {
+  char msg[768];
+  snprintf(msg, sizeof msg, "%s", err->message);
+  return sph_node_error(fn, err, st, "%s %s", what, msg);
+}
+
 /* mesh: {file, units, flip_normals}: the file (relative to the scene's)
  * read, scaled to metres, checked for an inside and an outward surface */
 static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
@@ -47,19 +73,11 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
   if (s->dimension != 3)
     return sph_node_error(g, err, SPH_ERR_GEOMETRY,
                           "a mesh is a 3D shape (this scene is 2D)");
-  const char *file;
   int flip, u;
-  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
-  sph_node *fn = sph_node_child(g, "file");
-  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
-  SPH_TRY(sph_node_get_bool(g, "flip_normals", 0, 0, &flip, err));
-  if (!file[0] || strlen(file) >= sizeof sh->file)
-    return sph_node_error(fn, err, SPH_ERR_RANGE,
-                          "give the mesh file's name (under %zu bytes)",
-                          sizeof sh->file);
-  snprintf(sh->file, sizeof sh->file, "%s", file);
+  sph_node *fn;
   char path[1024];
-  sph_schema_file_path(fn, file, path, sizeof path);
+  SPH_TRY(shape_file(sh, g, "mesh", path, sizeof path, &u, &fn, err));
+  SPH_TRY(sph_node_get_bool(g, "flip_normals", 0, 0, &flip, err));
   double *tri;
   size_t n;
   sph_status st = sph_mesh_read(path, &tri, &n, err);
@@ -67,13 +85,10 @@ static sph_status parse_mesh(sph_scene *s, sph_shape *sh, sph_node *g,
     st = sph_mesh_create(&sh->mesh, tri, n, sph_length_scale[u], flip, err);
     free(tri);
   }
-  if (st != SPH_OK) {
-    char msg[768];
-    snprintf(msg, sizeof msg, "%s", err->message);
-    return sph_node_error(fn, err, st, "mesh %s", msg); /* "path: why" */
-  }
+  if (st != SPH_OK)
+    return shape_file_error(fn, "mesh", st, err);
   sph_schema_name_absolute(fn, path);
-  file = sh->file; /* the name as given (fn->value was it) */
+  const char *file = sh->file; /* the name as given (fn->value was it) */
   const sph_mesh_info *in = sph_mesh_get_info(sh->mesh);
   double box = 1.0;
   for (int c = 0; c < 3; ++c) {
@@ -197,18 +212,10 @@ static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
   if (s->dimension != 2)
     return sph_node_error(g, err, SPH_ERR_GEOMETRY,
                           "an outline is a 2D shape (in 3D use a mesh)");
-  const char *file;
   int u;
-  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
-  sph_node *fn = sph_node_child(g, "file");
-  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
-  if (!file[0] || strlen(file) >= sizeof sh->file)
-    return sph_node_error(fn, err, SPH_ERR_RANGE,
-                          "give the outline file's name (under %zu bytes)",
-                          sizeof sh->file);
-  snprintf(sh->file, sizeof sh->file, "%s", file);
+  sph_node *fn;
   char path[1024];
-  sph_schema_file_path(fn, file, path, sizeof path);
+  SPH_TRY(shape_file(sh, g, "outline", path, sizeof path, &u, &fn, err));
   double *xy;
   size_t *start, nr;
   sph_status st = sph_outline_read(path, &xy, &start, &nr, err);
@@ -220,11 +227,8 @@ static sph_status parse_outline(sph_scene *s, sph_shape *sh, sph_node *g,
     free(xy);
     free(start);
   }
-  if (st != SPH_OK) {
-    char msg[768];
-    snprintf(msg, sizeof msg, "%s", err->message);
-    return sph_node_error(fn, err, st, "outline %s", msg);
-  }
+  if (st != SPH_OK)
+    return shape_file_error(fn, "outline", st, err);
   sph_schema_name_absolute(fn, path);
   sph_polygon_bounds(sh->polygon, sh->min, sh->max);
   return SPH_OK;
@@ -236,25 +240,14 @@ static sph_status parse_cloud(sph_scene *s, sph_shape *sh, sph_node *g,
                               sph_error *err) {
   static const char *const keys[] = {"file", "units", NULL};
   SPH_TRY(sph_node_check_keys(g, keys, err));
-  const char *file;
   int u;
-  SPH_TRY(sph_node_get_string(g, "file", 1, NULL, &file, err));
-  sph_node *fn = sph_node_child(g, "file");
-  SPH_TRY(sph_node_get_choice(g, "units", sph_length_units, "m", &u, err));
-  if (!file[0] || strlen(file) >= sizeof sh->file)
-    return sph_node_error(fn, err, SPH_ERR_RANGE,
-                          "give the particle file's name (under %zu bytes)",
-                          sizeof sh->file);
-  snprintf(sh->file, sizeof sh->file, "%s", file);
+  sph_node *fn;
   char path[1024];
-  sph_schema_file_path(fn, file, path, sizeof path);
+  SPH_TRY(shape_file(sh, g, "particle", path, sizeof path, &u, &fn, err));
   sph_status st =
       sph_cloud_read(path, s->dimension, sph_length_scale[u], &sh->cloud, err);
-  if (st != SPH_OK) {
-    char msg[768];
-    snprintf(msg, sizeof msg, "%s", err->message);
-    return sph_node_error(fn, err, st, "particles %s", msg);
-  }
+  if (st != SPH_OK)
+    return shape_file_error(fn, "particles", st, err);
   sph_schema_name_absolute(fn, path);
   for (int c = 0; c < 3; ++c) {
     sh->min[c] = sh->cloud->lo[c];
