@@ -127,12 +127,12 @@ START_TEST(energy_growth_fires_on_growing_round_off) {
       "materials.rubber.poisson_ratio=0.45",
       "bodies.0.particles={count: [7, 7, 7], distribution: jitter, seed: 3}",
       "bodies.0.initial_velocity={uniform: [3, -2, 1]}",
-      "time.end=0.4"};
+      "time.end=0.3"};
   outcome a = run("spinning_cube", lit, 6, 0.01);
   assert_first(&a, SPH_INDICATOR_ENERGY_GROWTH, 0.23, 0.04);
   ck_assert_msg(strstr(a.reason, "from rest"), "%s", a.reason);
   const char *def[] = {
-      "method={name: tl-bond}", lit[1], lit[2], lit[3], lit[4], "time.end=0.4"};
+      "method={name: tl-bond}", lit[1], lit[2], lit[3], lit[4], "time.end=0.3"};
   outcome b = run("spinning_cube", def, 6, 0.01);
   ck_assert_msg(b.stable, "%s", b.reason);
 }
