@@ -750,6 +750,7 @@ sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *fr,
     v->lin_drift = fmax(v->lin_drift, sqrt(dl) / v->lin_scale);
   if (v->ang_scale > 0.0)
     v->ang_drift = fmax(v->ang_drift, sqrt(da) / v->ang_scale);
+  sph_verdict_energy_from_rest(v, fr, E, lin);
   /* pressure checkerboard (over MPI ranks the owned particles change with
    * migration: their parities are taken again) */
   const double *p = ps->field[SPH_FIELD_PRESSURE];

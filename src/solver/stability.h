@@ -97,6 +97,7 @@ const char *sph_indicator_key(sph_indicator i);
 
 #define SPH_ENERGY_GROWTH_MAX 0.05
 #define SPH_ENERGY_FLOOR 1e-20
+#define SPH_REST_START 1e-12
 #define SPH_CHECKERBOARD_MAX 0.5
 #define SPH_FRACTURE_ADJACENT 1.5
 #define SPH_FRACTURE_DP 2.0
@@ -180,6 +181,13 @@ void sph_verdict_destroy(sph_verdict *v);
  * verdict on all. */
 sph_status sph_verdict_observe(sph_verdict *v, const sph_frame *frame,
                                sph_error *err);
+
+/* stability_rest.c: `energy_growth` when a free body (no boundary, wall
+ * or external work) that started at rest or translating rigidly holds a
+ * kinetic energy relative to its mean velocity above the energy floor (E:
+ * the frame's kinetic + strain energy, lin: its linear momentum) */
+void sph_verdict_energy_from_rest(sph_verdict *v, const sph_frame *frame,
+                                  double E, const double lin[3]);
 
 /* Records that indicator i tripped at time t; the first one marks the run
  * unstable with its reason. */

@@ -64,6 +64,27 @@ static void laplacian(const jst *j, const double *wl, const double *u,
     laplacian1(j, wl, u, self, cs, cl, out, n);
 }
 
+/* out_a += cl (sum_b adj_ab (w_b - w_a) + diag_a w_a): the adjoint outer
+ * sweep (jst_params.lap_adj) */
+static void laplacian_adj3(const jst *j, const double *w, double cl,
+                           double *out, long n) {
+  const sph_neighbors *nl = j->p.nl;
+  const double *adj = j->p.lap_adj, *diag = j->p.lap_diag;
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n; ++a) {
+    double s[3] = {0.0, 0.0, 0.0};
+    const double *wa = w + 3 * a;
+    for (size_t k = nl->offset[a]; k < nl->offset[a + 1]; ++k) {
+      const double *wb = w + 3 * (size_t)nl->index[k];
+      s[0] += adj[k] * (wb[0] - wa[0]);
+      s[1] += adj[k] * (wb[1] - wa[1]);
+      s[2] += adj[k] * (wb[2] - wa[2]);
+    }
+    for (int c = 0; c < 3; ++c)
+      out[3 * a + c] += cl * (s[c] + diag[a] * wa[c]);
+  }
+}
+
 static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
                             sph_error *err) {
   jst *j = term->data;
@@ -90,7 +111,13 @@ static sph_status jst_rates(sph_term *term, sph_sim *sim, sph_stage *stage,
       sph_mirror_scalar(sim->mirror, j->lu, 0.0);
   }
   long len = nc * n;
-  if (j->p.lap_sym) { /* eq. 28: D = c2 S[u] - c4 S[L[u]] */
+  if (j->p.lap_sym && j->p.lap_adj) { /* D = c2 S[u] - c4 L*[L[u]] */
+    if (c2 != 0.0)
+      laplacian(j, j->p.lap_sym, u, NULL, 0.0, c2, j->d, n);
+    else
+      memset(j->d, 0, (size_t)len * sizeof *j->d);
+    laplacian_adj3(j, j->lu, -c4, j->d, n);
+  } else if (j->p.lap_sym) { /* eq. 28: D = c2 S[u] - c4 S[L[u]] */
     if (c2 != 0.0)
       laplacian(j, j->p.lap_sym, u, NULL, 0.0, c2, j->d, n);
     laplacian(j, j->p.lap_sym, j->lu, c2 != 0.0 ? j->d : NULL, 1.0, -c4, j->d,

@@ -48,6 +48,13 @@ typedef struct jst_params {
    * V_b (Lap W~_b(X_a) + Lap W~_a(X_b)) / 2 per slot, the inner Laplacian
    * (eq. 27) stays `lap` */
   const double *lap_sym;
+  /* with lap_sym, the outer sums of the eps4 term as the adjoint of the
+   * inner Laplacian in the volume-weighted inner product (NULL: eq. 28):
+   * L*[w]_a = sum_b lap_adj_ab (w_b - w_a) + lap_diag_a w_a with
+   * lap_adj_ab = V_b Lap W~_a(X_b) and lap_diag_a = sum_b (lap_adj_ab -
+   * V_b Lap W~_b(X_a)), so that -eps4 c_p h^3 L*[L[u]] is dissipative,
+   * conserves momentum and vanishes on linear u like eq. 28 */
+  const double *lap_adj, *lap_diag;
   const double *cp_now; /* c_p of the step (NULL: cp) */
   /* L[u] of the real particles summed by the method in its own pair sweep
    * before the term runs, in this term's arithmetic (NULL: the term sums

@@ -221,6 +221,7 @@ START_TEST(option_errors) {
       {"method={name: tl-bond, force: eq31}", "force"},
       {"method={name: tl-bond, jst: {eps4_p: -1}}", "eps4_p"},
       {"method={name: tl-bond, jst: {eps4_J: 1}}", "eps4_J"},
+      {"method={name: tl-bond, jst: {outer: eq28}}", "outer"},
       {"method={name: tl-bond, fields: pFJ}", "fields"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof *bad; ++i) {

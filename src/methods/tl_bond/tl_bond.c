@@ -211,9 +211,9 @@ static void tl_bond_destroy(sph_sim *sim) {
   if (!m)
     return;
   sph_ref_destroy(&m->ref);
-  double *arrays[] = {m->v,       m->gv, m->fa, m->fb,  m->q,  m->lap,
-                      m->lap_sym, m->Mc, m->Fc, m->lam, m->x0, m->p0,
-                      m->F0,      m->dx, m->dp, m->dF};
+  double *arrays[] = {m->v,       m->gv,      m->fa,       m->fb, m->q,  m->lap,
+                      m->lap_sym, m->lap_adj, m->lap_diag, m->Mc, m->Fc, m->lam,
+                      m->x0,      m->p0,      m->F0,       m->dx, m->dp, m->dF};
   for (size_t i = 0; i < sizeof arrays / sizeof *arrays; ++i)
     free(arrays[i]);
   free(m);
@@ -291,6 +291,10 @@ static sph_status pair_weights(tl_bond *m, sph_sim *sim, int first_order,
       if (need_lap) {
         m->lap[k] = Vb * lap[k];
         m->lap_sym[k] = 0.5 * Vb * (lap[k] + lap[rev[k]]);
+        if (m->lap_adj) {
+          m->lap_adj[k] = Vb * lap[rev[k]];
+          m->lap_diag[a] += m->lap_adj[k] - m->lap[k];
+        }
       }
     }
   }
@@ -312,6 +316,7 @@ typedef struct tl_bond_options {
   sph_rk_step integrate;
   double cfl;
   double e2p, e4p; /* JST on p */
+  int adjoint;     /* jst.outer: adjoint (else eq. 28's symmetric sums) */
 } tl_bond_options;
 
 static sph_status tl_bond_options_parse(sph_node *opt, tl_bond_options *o,
@@ -327,7 +332,7 @@ static sph_status tl_bond_options_parse(sph_node *opt, tl_bond_options *o,
   static const char *const speeds[] = {"pair", "linear", NULL};
   static const char *const forces[] = {"symmetric", "conservative", NULL};
   int dg, corr, integ, ws, fo;
-  SPH_TRY(sph_node_get_choice(opt, "force", forces, "symmetric", &fo, err));
+  SPH_TRY(sph_node_get_choice(opt, "force", forces, "conservative", &fo, err));
   SPH_TRY(sph_node_get_choice(opt, "deformation_gradient", defgrads, "bond",
                               &dg, err));
   SPH_TRY(sph_node_get_choice(opt, "correction", corrections, "first_order",
@@ -351,8 +356,12 @@ static sph_status tl_bond_options_parse(sph_node *opt, tl_bond_options *o,
   SPH_TRY(sph_node_insert_default(opt, "jst", "{}", &jst, err));
   if (jst->kind != SPH_NODE_MAP)
     return sph_node_error(jst, err, SPH_ERR_TYPE, "expected a mapping");
-  static const char *const jkeys[] = {"eps2_p", "eps4_p", NULL};
+  static const char *const jkeys[] = {"eps2_p", "eps4_p", "outer", NULL};
   SPH_TRY(sph_node_check_keys(jst, jkeys, err));
+  static const char *const outers[] = {"adjoint", "symmetric", NULL};
+  int outer;
+  SPH_TRY(sph_node_get_choice(jst, "outer", outers, "adjoint", &outer, err));
+  o->adjoint = outer == 0;
   SPH_TRY(sph_node_get_double(jst, "eps2_p", 0, 0.0, &o->e2p, err));
   SPH_TRY(sph_node_get_double(jst, "eps4_p", 0, 0.125, &o->e4p, err));
   if (o->e2p < 0.0 || o->e4p < 0.0)
@@ -392,6 +401,10 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   if (need_lap) {
     SPH_TRY(alloc_zero(&m->lap, count, err));
     SPH_TRY(alloc_zero(&m->lap_sym, count, err));
+    if (o.adjoint) {
+      SPH_TRY(alloc_zero(&m->lap_adj, count, err));
+      SPH_TRY(alloc_zero(&m->lap_diag, ne, err));
+    }
   }
   SPH_TRY(alloc_zero(&m->Mc, 9 * ne, err));
   SPH_TRY(alloc_zero(&m->v, 3 * ne, err));
@@ -424,6 +437,8 @@ static sph_status tl_bond_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
                      .cp = m->ref.cp,
                      .h = sim->dp,
                      .lap_sym = m->lap_sym,
+                     .lap_adj = m->lap_adj,
+                     .lap_diag = m->lap_diag,
                      .cp_now = m->pair_speed ? &m->cp_now : NULL};
     SPH_TRY(jst_dissipation_create(sim, &jp, err));
   }

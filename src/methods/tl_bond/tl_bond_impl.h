@@ -21,6 +21,9 @@ typedef struct tl_bond {
   double *q;       /* V_b W~_b(X_a) (X_b - X_a) / |X_b - X_a|^2, eq. 37-39 */
   double *lap;     /* V_b Lap W~_b(X_a), eq. 27 */
   double *lap_sym; /* V_b (Lap W~_b(X_a) + Lap W~_a(X_b)) / 2, eq. 28 */
+  double
+      *lap_adj; /* V_b Lap W~_a(X_b): the adjoint outer sums (NULL: eq. 28) */
+  double *lap_diag; /* per point: sum_b (lap_adj - lap), ibid. */
   /* per point */
   double *Mc;  /* I - sum_b (X_b - X_a) (x) q_ab, 9 each */
   double *Fc;  /* the F the stress is evaluated at, 9 each */
