@@ -12,23 +12,7 @@ src=$2
 meshes=$src/tests/data/meshes
 mkdir -p "$work/case/parts"
 cp "$meshes"/*.stl "$work/case/parts/"
-cat >"$work/case/box.yaml" <<'YAML'
-name: cube
-dimension: 3
-method: {name: tl-jst}
-materials:
-  rubber: {model: neo-hookean, density: 1100, youngs_modulus: 17e6, poisson_ratio: 0.45}
-bodies:
-  - name: cube
-    material: rubber
-    shape: {box: {min: [0, 0, 0], max: [1, 1, 1]}}
-    particles: {count: [5, 6, 7]}
-    initial_velocity: {rotation: {axis: y, omega: 10, center: [0.5, 0, 0.5]}}
-boundaries:
-  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: true}
-time: {end: 0.004}
-output: {every: 0.002}
-YAML
+cube_scene "$work/case/box.yaml" "{every: 0.002}"
 sed 's|{box: {min: \[0, 0, 0\], max: \[1, 1, 1\]}}|{mesh: {file: parts/cube.stl}}|' \
   "$work/case/box.yaml" >"$work/case/mesh.yaml"
 grep -q 'parts/cube.stl' "$work/case/mesh.yaml" || bad "the mesh scene was not made"
