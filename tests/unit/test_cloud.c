@@ -52,11 +52,7 @@ START_TEST(test_box_csv_is_the_box) {
   snprintf(shape, sizeof shape, "{particles: {file: %s}}", csv_path);
   sph_particles *p = particles_of(3, shape, NULL, NULL);
   unlink(csv_path);
-  ck_assert_uint_eq(p->n, b->n);
-  ck_assert(!memcmp(b->field[SPH_FIELD_POSITION0],
-                    p->field[SPH_FIELD_POSITION0], 3 * b->n * sizeof(double)));
-  ck_assert(!memcmp(b->field[SPH_FIELD_VOLUME0], p->field[SPH_FIELD_VOLUME0],
-                    b->n * sizeof(double)));
+  sph_test_assert_same_particles(b, p, "box.csv");
   sph_particles_destroy(b);
   sph_particles_destroy(p);
 }

@@ -37,19 +37,6 @@ static sph_particles *particles_of(const char *shape, const char *particles,
   return sph_test_scene_particles(text, shape);
 }
 
-static void assert_same(const sph_particles *a, const sph_particles *b,
-                        const char *what) {
-  ck_assert_msg(a->n == b->n, "%s: %zu particles, expected %zu", what, b->n,
-                a->n);
-  ck_assert_msg(!memcmp(a->field[SPH_FIELD_POSITION0],
-                        b->field[SPH_FIELD_POSITION0],
-                        3 * a->n * sizeof(double)),
-                "%s: positions differ", what);
-  ck_assert_msg(!memcmp(a->field[SPH_FIELD_VOLUME0],
-                        b->field[SPH_FIELD_VOLUME0], a->n * sizeof(double)),
-                "%s: volumes differ", what);
-}
-
 static const char *const box = "{box: {min: [0, 0, 0], max: [1, 1, 1]}}";
 static const char *const lattices[] = {"{count: [5, 6, 7]}", "{spacing: 0.1}",
                                        "{spacing: 0.1, distribution: jitter}"};
@@ -60,7 +47,7 @@ START_TEST(test_cube_is_the_box) {
   sph_particles *m =
       particles_of("{mesh: {file: " MESHES "cube.stl}}", lattices[0], NULL);
   ck_assert_uint_eq(b->n, 5 * 6 * 7);
-  assert_same(b, m, "cube.stl, count");
+  sph_test_assert_same_particles(b, m, "cube.stl, count");
   sph_particles_destroy(b);
   sph_particles_destroy(m);
 }
@@ -80,7 +67,7 @@ START_TEST(test_defective_cubes) {
       sph_particles *m = particles_of(files[f], lattices[l], NULL);
       char what[256];
       snprintf(what, sizeof what, "%s, %s", files[f], lattices[l]);
-      assert_same(ref, m, what);
+      sph_test_assert_same_particles(ref, m, what);
       sph_particles_destroy(m);
     }
     sph_particles_destroy(ref);
@@ -146,7 +133,7 @@ START_TEST(test_threads) {
   omp_set_num_threads(2);
   sph_particles *two = particles_of("{mesh: {file: " MESHES "icosphere.obj}}",
                                     "{spacing: 0.02}", NULL);
-  assert_same(one, two, "1 and 2 threads");
+  sph_test_assert_same_particles(one, two, "1 and 2 threads");
   sph_particles_destroy(one);
   sph_particles_destroy(two);
 }
@@ -237,12 +224,8 @@ static void refused(const char *shape, const char *particles, sph_status code,
   sph_scene *s;
   sph_error err;
   sph_status st = load(shape, particles, NULL, &s, &err);
-  ck_assert_msg(st == code, "%s: got %s (%s)", shape, sph_status_name(st),
-                err.message);
+  sph_test_assert_refused(st, &err, shape, code, key, fragment);
   ck_assert_int_eq(err.line, strstr(key, "particles") ? 11 : 10);
-  ck_assert_msg(!strcmp(err.key, key), "key %s, expected %s", err.key, key);
-  ck_assert_msg(strstr(err.message, fragment), "message '%s' lacks '%s'",
-                err.message, fragment);
 }
 
 START_TEST(test_bad_input) {
@@ -270,7 +253,7 @@ START_TEST(test_bad_input) {
   sph_particles *b = particles_of("{mesh: {file: " MESHES
                                   "cube_inverted.stl, flip_normals: true}}",
                                   p, NULL);
-  assert_same(a, b, "flip_normals");
+  sph_test_assert_same_particles(a, b, "flip_normals");
   sph_particles_destroy(a);
   sph_particles_destroy(b);
 }

@@ -39,11 +39,7 @@ START_TEST(test_square_is_the_box) {
                                   "{spacing: 0.05}", NULL);
   sph_particles *p = particles_of(square, "{spacing: 0.05}", NULL);
   ck_assert_uint_eq(b->n, 400);
-  ck_assert_uint_eq(p->n, b->n);
-  ck_assert(!memcmp(b->field[SPH_FIELD_POSITION0],
-                    p->field[SPH_FIELD_POSITION0], 3 * b->n * sizeof(double)));
-  ck_assert(!memcmp(b->field[SPH_FIELD_VOLUME0], p->field[SPH_FIELD_VOLUME0],
-                    b->n * sizeof(double)));
+  sph_test_assert_same_particles(b, p, "square");
   sph_particles_destroy(b);
   sph_particles_destroy(p);
 }
@@ -110,11 +106,7 @@ static void refused(int dim, const char *shape, const char *particles,
   sph_scene *s;
   sph_error err;
   sph_status st = load(dim, shape, particles, NULL, &s, &err);
-  ck_assert_msg(st == code, "%s: got %s (%s)", shape, sph_status_name(st),
-                err.message);
-  ck_assert_msg(!strcmp(err.key, key), "key %s, expected %s", err.key, key);
-  ck_assert_msg(strstr(err.message, fragment), "message '%s' lacks '%s'",
-                err.message, fragment);
+  sph_test_assert_refused(st, &err, shape, code, key, fragment);
 }
 
 START_TEST(test_bad_input) {

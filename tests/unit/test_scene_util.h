@@ -85,6 +85,35 @@ static inline sph_particles *sph_test_scene_particles(const char *text,
   return ps;
 }
 
+/* Asserts that a and b are the same particles: count, positions and
+ * volumes to the bit (`what` labels a failure). */
+static inline void sph_test_assert_same_particles(const sph_particles *a,
+                                                  const sph_particles *b,
+                                                  const char *what) {
+  ck_assert_msg(a->n == b->n, "%s: %zu particles, expected %zu", what, b->n,
+                a->n);
+  ck_assert_msg(!memcmp(a->field[SPH_FIELD_POSITION0],
+                        b->field[SPH_FIELD_POSITION0],
+                        3 * a->n * sizeof(double)),
+                "%s: positions differ", what);
+  ck_assert_msg(!memcmp(a->field[SPH_FIELD_VOLUME0],
+                        b->field[SPH_FIELD_VOLUME0], a->n * sizeof(double)),
+                "%s: volumes differ", what);
+}
+
+/* Asserts that a load of `shape` returned `code` (st), its error at `key`
+ * with `fragment` in the message. */
+static inline void sph_test_assert_refused(sph_status st, const sph_error *err,
+                                           const char *shape, sph_status code,
+                                           const char *key,
+                                           const char *fragment) {
+  ck_assert_msg(st == code, "%s: got %s (%s)", shape, sph_status_name(st),
+                err->message);
+  ck_assert_msg(!strcmp(err->key, key), "key %s, expected %s", err->key, key);
+  ck_assert_msg(strstr(err->message, fragment), "message '%s' lacks '%s'",
+                err->message, fragment);
+}
+
 /* qsort order of 3-vectors: lexicographic */
 static inline int sph_test_cmp_point(const void *a, const void *b) {
   const double *x = a, *y = b;
