@@ -28,3 +28,13 @@ time: {end: 0.004}
 output: $2
 YAML
 }
+
+# refused_run SCENE PLACE TEXT LABEL: "$sph run SCENE" exits 2 with PLACE
+# and TEXT in its error and writes nothing
+refused_run() {
+  rm -rf "$work/bad"
+  "$sph" run "$1" --out "$work/bad" --quiet >/dev/null 2>"$work/err"
+  local rc=$?
+  [ $rc -eq 2 ] && grep -qF "$2" "$work/err" && grep -qF -- "$3" "$work/err" &&
+    [ ! -e "$work/bad" ] && ok || bad "$4 (exit $rc): $(cat "$work/err")"
+}

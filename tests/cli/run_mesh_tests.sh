@@ -52,11 +52,7 @@ sed 's|parts/cube_top.stl|parts/nothing.stl|' "$work/case/near.yaml" >"$work/cas
 # refused: exit 2 at the file key (line 9, column 30), nothing written
 refuse() { # FILE_OR_KEY=VALUE EXPECTED
   sed "s|parts/cube.stl|$1|" "$work/case/mesh.yaml" >"$work/case/bad.yaml"
-  rm -rf "$work/bad"
-  "$sph" run "$work/case/bad.yaml" --out "$work/bad" --quiet >/dev/null 2>"$work/err"
-  local rc=$?
-  [ $rc -eq 2 ] && grep -qF "$work/case/bad.yaml:9:" "$work/err" && grep -qF -- "$2" "$work/err" &&
-    [ ! -e "$work/bad" ] && ok || bad "$1 (exit $rc): $(cat "$work/err")"
+  refused_run "$work/case/bad.yaml" "$work/case/bad.yaml:9:" "$2" "$1"
 }
 refuse parts/none.stl "parts/none.stl: no such file"
 : >"$work/case/parts/empty.stl"

@@ -87,11 +87,7 @@ array "$work/more/cube_0000.vtp" displacement | tr ' ' '\n' | grep -qv '^0$' &&
 # refused: exit 2 at the file key (line 9, column 25), nothing written
 refuse() { # FILE EXPECTED [SCENE]
   sed "s|parts/box.csv|$1|" "$work/case/${3:-csv}.yaml" >"$work/case/bad.yaml"
-  rm -rf "$work/bad"
-  "$sph" run "$work/case/bad.yaml" --out "$work/bad" --quiet >/dev/null 2>"$work/err"
-  local rc=$?
-  [ $rc -eq 2 ] && grep -qF "$work/case/bad.yaml:9:25" "$work/err" && grep -qF -- "$2" "$work/err" &&
-    [ ! -e "$work/bad" ] && ok || bad "$1 (exit $rc): $(cat "$work/err")"
+  refused_run "$work/case/bad.yaml" "$work/case/bad.yaml:9:25" "$2" "$1"
 }
 csv() { # NAME LINES...
   local f=$work/case/parts/$1
