@@ -28,35 +28,18 @@ struct sph_gpu_step {
 
 #define THREADS 128
 
-__global__ void save_kernel(sph_gpu_tl_jst g) {
-  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (a < g.n)
-    sph_gpu_save_one(a, &g);
-}
-
-__global__ void stress_kernel(sph_gpu_tl_jst g) {
-  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (a < g.n)
-    sph_gpu_stress_one(a, &g);
-}
-
-__global__ void rates_kernel(sph_gpu_tl_jst g) {
-  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (a < g.n)
-    sph_gpu_rates_one(a, &g);
-}
-
-__global__ void jst_kernel(sph_gpu_tl_jst g) {
-  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (a < g.n)
-    sph_gpu_jst_one(a, &g);
-}
-
-__global__ void finish_kernel(sph_gpu_tl_jst g) {
-  size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;
-  if (a < g.n)
-    sph_gpu_finish_one(a, &g);
-}
+/* NAME_kernel: one thread per particle calling sph_gpu_NAME_one */
+#define PER_PARTICLE_KERNEL(NAME)                                              \
+  __global__ void NAME##_kernel(sph_gpu_tl_jst g) {                            \
+    size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;                  \
+    if (a < g.n)                                                               \
+      sph_gpu_##NAME##_one(a, &g);                                             \
+  }
+PER_PARTICLE_KERNEL(save)
+PER_PARTICLE_KERNEL(stress)
+PER_PARTICLE_KERNEL(rates)
+PER_PARTICLE_KERNEL(jst)
+PER_PARTICLE_KERNEL(finish)
 
 __global__ void xmoment_kernel(sph_gpu_tl_jst g, double dt) {
   size_t a = (size_t)blockIdx.x * blockDim.x + threadIdx.x;

@@ -14,6 +14,7 @@
 #include <strings.h>
 
 #include "io/vtk_read.h"
+#include "text_lines.h"
 
 #define CLOUD_MAX_BYTES (1L << 30)
 
@@ -155,19 +156,10 @@ static sph_status csv_row(reader *R, char *s, long line, const int col[NCOL],
 
 static sph_status read_csv(reader *R, char *text, int *has_z) {
   long line = 0;
-  int col[NCOL], nfields = 0, header = 0;
+  int col[NCOL] = {0}, nfields = 0, header = 0; /* col: set by csv_header */
   sph_status st = SPH_OK;
-  for (char *s = text, *e; s && st == SPH_OK; s = e ? e + 1 : NULL) {
-    e = strchr(s, '\n');
-    if (e)
-      *e = '\0';
-    ++line;
-    char *hash = strchr(s, '#');
-    if (hash)
-      *hash = '\0';
-    char *q = s;
-    while (isspace((unsigned char)*q))
-      ++q;
+  for (char *s = text; s && st == SPH_OK;) {
+    char *q = sph_text_line(&s, &line);
     if (!*q)
       continue;
     if (!header) {

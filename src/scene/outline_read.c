@@ -13,6 +13,8 @@
 #include <string.h>
 #include <strings.h>
 
+#include "text_lines.h"
+
 #define OUTLINE_MAX_BYTES (64L << 20)
 
 typedef struct rings {
@@ -71,17 +73,8 @@ static sph_status fail(rings *R, sph_status st, long line, const char *what) {
 static void read_csv(rings *R, char *text) {
   long line = 0;
   int numbers_seen = 0, header = 0;
-  for (char *s = text, *e; s && R->st == SPH_OK; s = e ? e + 1 : NULL) {
-    e = strchr(s, '\n');
-    if (e)
-      *e = '\0';
-    ++line;
-    char *hash = strchr(s, '#');
-    if (hash)
-      *hash = '\0';
-    char *q = s;
-    while (isspace((unsigned char)*q))
-      ++q;
+  for (char *s = text; s && R->st == SPH_OK;) {
+    char *q = sph_text_line(&s, &line);
     if (!*q) {
       if (!ring_break(R))
         fail(R, SPH_ERR_NOMEM, 0, "outline");

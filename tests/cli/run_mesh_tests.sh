@@ -12,23 +12,7 @@ src=$2
 meshes=$src/tests/data/meshes
 mkdir -p "$work/case/parts"
 cp "$meshes"/*.stl "$work/case/parts/"
-cat >"$work/case/box.yaml" <<'YAML'
-name: cube
-dimension: 3
-method: {name: tl-jst}
-materials:
-  rubber: {model: neo-hookean, density: 1100, youngs_modulus: 17e6, poisson_ratio: 0.45}
-bodies:
-  - name: cube
-    material: rubber
-    shape: {box: {min: [0, 0, 0], max: [1, 1, 1]}}
-    particles: {count: [5, 6, 7]}
-    initial_velocity: {rotation: {axis: y, omega: 10, center: [0.5, 0, 0.5]}}
-boundaries:
-  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: true}
-time: {end: 0.004}
-output: {every: 0.002}
-YAML
+cube_scene "$work/case/box.yaml" "{every: 0.002}"
 sed 's|{box: {min: \[0, 0, 0\], max: \[1, 1, 1\]}}|{mesh: {file: parts/cube.stl}}|' \
   "$work/case/box.yaml" >"$work/case/mesh.yaml"
 grep -q 'parts/cube.stl' "$work/case/mesh.yaml" || bad "the mesh scene was not made"
@@ -68,11 +52,7 @@ sed 's|parts/cube_top.stl|parts/nothing.stl|' "$work/case/near.yaml" >"$work/cas
 # refused: exit 2 at the file key (line 9, column 30), nothing written
 refuse() { # FILE_OR_KEY=VALUE EXPECTED
   sed "s|parts/cube.stl|$1|" "$work/case/mesh.yaml" >"$work/case/bad.yaml"
-  rm -rf "$work/bad"
-  "$sph" run "$work/case/bad.yaml" --out "$work/bad" --quiet >/dev/null 2>"$work/err"
-  local rc=$?
-  [ $rc -eq 2 ] && grep -qF "$work/case/bad.yaml:9:" "$work/err" && grep -qF -- "$2" "$work/err" &&
-    [ ! -e "$work/bad" ] && ok || bad "$1 (exit $rc): $(cat "$work/err")"
+  refused_run "$work/case/bad.yaml" "$work/case/bad.yaml:9:" "$2" "$1"
 }
 refuse parts/none.stl "parts/none.stl: no such file"
 : >"$work/case/parts/empty.stl"

@@ -10,23 +10,7 @@ sph=$(realpath "$1")
 with_mpi=${2:-0} # 1: sph is built with MPI (the .pvtp of a 2-rank run)
 . "$(dirname "$0")/harness.sh"
 mkdir -p "$work/case/parts"
-cat >"$work/case/box.yaml" <<'YAML'
-name: cube
-dimension: 3
-method: {name: tl-jst}
-materials:
-  rubber: {model: neo-hookean, density: 1100, youngs_modulus: 17e6, poisson_ratio: 0.45}
-bodies:
-  - name: cube
-    material: rubber
-    shape: {box: {min: [0, 0, 0], max: [1, 1, 1]}}
-    particles: {count: [5, 6, 7]}
-    initial_velocity: {rotation: {axis: y, omega: 10, center: [0.5, 0, 0.5]}}
-boundaries:
-  - {name: base, select: {plane: {axis: y, at: 0}}, clamp: true}
-time: {end: 0.004}
-output: {every: 0.002, fields: [pressure, velocity, displacement, von_mises, J, body_id, volume]}
-YAML
+cube_scene "$work/case/box.yaml" "{every: 0.002, fields: [pressure, velocity, displacement, von_mises, J, body_id, volume]}"
 # the box's spacing, 1/6 as %.17g: the same dp, so the same kernel
 sed 's|{box: {min: \[0, 0, 0\], max: \[1, 1, 1\]}}|{particles: {file: parts/box.csv}}|;
      s|particles: {count: \[5, 6, 7\]}|particles: {spacing: 0.16666666666666666}|' \
@@ -103,11 +87,7 @@ array "$work/more/cube_0000.vtp" displacement | tr ' ' '\n' | grep -qv '^0$' &&
 # refused: exit 2 at the file key (line 9, column 25), nothing written
 refuse() { # FILE EXPECTED [SCENE]
   sed "s|parts/box.csv|$1|" "$work/case/${3:-csv}.yaml" >"$work/case/bad.yaml"
-  rm -rf "$work/bad"
-  "$sph" run "$work/case/bad.yaml" --out "$work/bad" --quiet >/dev/null 2>"$work/err"
-  local rc=$?
-  [ $rc -eq 2 ] && grep -qF "$work/case/bad.yaml:9:25" "$work/err" && grep -qF -- "$2" "$work/err" &&
-    [ ! -e "$work/bad" ] && ok || bad "$1 (exit $rc): $(cat "$work/err")"
+  refused_run "$work/case/bad.yaml" "$work/case/bad.yaml:9:25" "$2" "$1"
 }
 csv() { # NAME LINES...
   local f=$work/case/parts/$1

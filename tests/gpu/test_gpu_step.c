@@ -23,6 +23,7 @@
 #include "gpu/gpu.h"
 #include "scene/scene.h"
 #include "solver/sim.h"
+#include "test_column.h"
 
 #define SKIP 77
 
@@ -73,20 +74,7 @@ static double now(void) {
 
 static sph_scene *column(const char *method, int k, double height) {
   char text[2048], path[64] = "/tmp/sph_gpu_XXXXXX";
-  snprintf(text, sizeof text,
-           "name: t\ndimension: 3\nmethod: %s\n"
-           "kernel: {type: cubic, h_over_dp: 1.3}\n"
-           "materials: {rubber: {model: neo-hookean, density: 1100, "
-           "youngs_modulus: 17e6, poisson_ratio: 0.45}}\n"
-           "bodies:\n  - name: column\n    material: rubber\n"
-           "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, %g, 0.5]}}\n"
-           "    particles: {count: [%d, %d, %d], distribution: jitter, "
-           "jitter: 0.2, seed: 7}\n"
-           "    initial_velocity: {rotation: {axis: y, omega: 105, center: "
-           "[0, 0, 0], profile: \"sin(pi*y/(2*%g))\"}}\n"
-           "boundaries:\n  - {name: base, select: {plane: {axis: y, at: 0}}, "
-           "clamp: true}\ntime: {end: 1}\n",
-           method, height, k, (int)lround(k * height), k, height);
+  sph_test_column_text(text, sizeof text, method, k, height);
   FILE *f = fdopen(mkstemp(path), "w");
   if (!f || fputs(text, f) < 0 || fclose(f) != 0)
     return NULL;
@@ -96,15 +84,6 @@ static sph_scene *column(const char *method, int k, double height) {
     fprintf(stderr, "scene: %s\n", err.message);
   remove(path);
   return s;
-}
-
-static double rel_diff(const double *a, const double *b, size_t len) {
-  double d = 0.0, m = 0.0;
-  for (size_t i = 0; i < len; ++i) {
-    d = fmax(d, fabs(a[i] - b[i]));
-    m = fmax(m, fabs(b[i]));
-  }
-  return m > 0.0 ? d / m : d;
 }
 
 /* CPU and device over `steps` steps; 0 when every field is within tol */
@@ -147,7 +126,7 @@ static int compare(const char *label, const char *method, int steps,
   for (int f = 0; f < 3; ++f)
     for (int i = 0; i < count; ++i)
       if (strcmp(arr[i].name, names[f]) == 0) {
-        double e = rel_diff(y[0][f], arr[i].data, arr[i].len);
+        double e = sph_test_rel_diff(y[0][f], arr[i].data, arr[i].len);
         int same = memcmp(y[0][f], y[1][f], arr[i].len * sizeof(double)) == 0;
         printf(" %s %.3g%s", names[f], e, same ? "" : " (runs differ)");
         fail |= !(e <= tol) || !same;

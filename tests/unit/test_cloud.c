@@ -3,6 +3,7 @@
  * the spacing estimate is the brute-force median nearest-neighbour
  * distance, units scale positions and volumes, the body's transform moves
  * the file's particles, and +0 and -0 are one position. */
+#include "test_scene_util.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -21,38 +22,10 @@ static char csv_path[64];
 static sph_particles *particles_of(int dim, const char *shape,
                                    const char *particles,
                                    const char *transform) {
-  char text[2048], path[64] = "/tmp/sph_cloud_XXXXXX";
-  snprintf(text, sizeof text,
-           "name: t\n"
-           "dimension: %d\n"
-           "method: {name: tl-jst}\n"
-           "materials:\n"
-           "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "
-           "poisson_ratio: 0.3}\n"
-           "time: {end: 0.1}\n"
-           "bodies:\n"
-           "  - name: part\n"
-           "    material: m\n"
-           "    shape: %s\n"
-           "%s%s\n"
-           "%s%s\n",
-           dim, shape, particles ? "    particles: " : "",
-           particles ? particles : "", transform ? "    transform: " : "",
-           transform ? transform : "");
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  sph_scene *s;
-  sph_error err;
-  sph_status st = sph_scene_load(&s, path, NULL, 0, &err);
-  unlink(path);
-  ck_assert_msg(st == SPH_OK, "%s: %s", shape, err.message);
-  sph_particles *ps;
-  st = sph_scene_build_particles(s, &ps, &err);
-  ck_assert_msg(st == SPH_OK, "%s: %s", shape, err.message);
-  sph_scene_destroy(s);
-  return ps;
+  char text[2048];
+  sph_test_one_body(text, sizeof text, dim, "tl-jst", shape, particles,
+                    transform);
+  return sph_test_scene_particles(text, shape);
 }
 
 /* ps's particles as a CSV (17 digits: exact) at csv_path */
@@ -79,11 +52,7 @@ START_TEST(test_box_csv_is_the_box) {
   snprintf(shape, sizeof shape, "{particles: {file: %s}}", csv_path);
   sph_particles *p = particles_of(3, shape, NULL, NULL);
   unlink(csv_path);
-  ck_assert_uint_eq(p->n, b->n);
-  ck_assert(!memcmp(b->field[SPH_FIELD_POSITION0],
-                    p->field[SPH_FIELD_POSITION0], 3 * b->n * sizeof(double)));
-  ck_assert(!memcmp(b->field[SPH_FIELD_VOLUME0], p->field[SPH_FIELD_VOLUME0],
-                    b->n * sizeof(double)));
+  sph_test_assert_same_particles(b, p, "box.csv");
   sph_particles_destroy(b);
   sph_particles_destroy(p);
 }

@@ -16,26 +16,13 @@
 #include "gpu/gpu.h"
 #include "scene/scene.h"
 #include "solver/sim.h"
+#include "test_column.h"
 #include "test_scene_util.h"
 
 /* a jittered 3 x 11 x 3 column, twisted, its base clamped */
 static sph_scene *column(const char *method) {
   char text[2048];
-  snprintf(text, sizeof text,
-           "name: t\ndimension: 3\nmethod: %s\n"
-           "kernel: {type: cubic, h_over_dp: 1.3}\n"
-           "materials: {rubber: {model: neo-hookean, density: 1100, "
-           "youngs_modulus: 17e6, poisson_ratio: 0.45}}\n"
-           "bodies:\n  - name: column\n    material: rubber\n"
-           "    shape: {box: {min: [-0.5, 0, -0.5], max: [0.5, 3, 0.5]}}\n"
-           "    particles: {count: [3, 9, 3], distribution: jitter, "
-           "jitter: 0.2, seed: 7}\n"
-           "    initial_velocity: {rotation: {axis: y, omega: 105, center: "
-           "[0, 0, 0], profile: \"sin(pi*y/(2*3))\"}}\n"
-           "boundaries:\n  - {name: base, select: {plane: {axis: y, at: 0}}, "
-           "clamp: true}\n"
-           "time: {end: 1}\n",
-           method);
+  sph_test_column_text(text, sizeof text, method, 3, 3.0);
   return sph_test_scene_text(text);
 }
 
@@ -47,16 +34,6 @@ static const sph_state_array *cpu_array(sph_state_array *arr, int count,
       return &arr[i];
   ck_abort_msg("no state array %s", name);
   return NULL;
-}
-
-/* the largest |twin - cpu| over the array, relative to its largest |cpu| */
-static double rel_diff(const double *twin, const double *cpu, size_t len) {
-  double d = 0.0, m = 0.0;
-  for (size_t i = 0; i < len; ++i) {
-    d = fmax(d, fabs(twin[i] - cpu[i]));
-    m = fmax(m, fabs(cpu[i]));
-  }
-  return m > 0.0 ? d / m : d;
 }
 
 static void twin_equals_cpu(const char *method, int steps) {
@@ -81,7 +58,7 @@ static void twin_equals_cpu(const char *method, int steps) {
       ck_assert_msg(memcmp(twin[f], c->data, c->len * sizeof(double)) == 0,
                     "%s, step %d: %s differs from the CPU's by %.3g relative",
                     method, k + 1, names[f],
-                    rel_diff(twin[f], c->data, c->len));
+                    sph_test_rel_diff(twin[f], c->data, c->len));
     }
   }
   sph_gpu_tl_jst_host_destroy(&g);

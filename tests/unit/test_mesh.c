@@ -5,6 +5,7 @@
  * an icosphere the sphere's count within one surface layer; a turned and
  * moved mesh body the pre-moved mesh; the same lattice on 1 and 2 threads;
  * rays through edges and vertices; and each refused input with its place. */
+#include "test_scene_util.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -20,64 +21,20 @@
 
 #define MESHES SPH_SOURCE_DIR "/tests/data/meshes/"
 
-/* a one-body scene: `shape` and `particles` as flow mappings */
-static void scene_text(char *buf, size_t size, const char *shape,
-                       const char *particles, const char *transform) {
-  snprintf(buf, size,
-           "name: t\n"
-           "dimension: 3\n"
-           "method: {name: tl-jst}\n"
-           "materials:\n"
-           "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "
-           "poisson_ratio: 0.3}\n"
-           "time: {end: 0.1}\n"
-           "bodies:\n"
-           "  - name: part\n"
-           "    material: m\n"
-           "    shape: %s\n"
-           "    particles: %s\n"
-           "%s%s\n",
-           shape, particles, transform ? "    transform: " : "",
-           transform ? transform : "");
-}
-
 static sph_status load(const char *shape, const char *particles,
                        const char *transform, sph_scene **s, sph_error *err) {
-  char text[2048], path[64] = "/tmp/sph_mesh_XXXXXX";
-  scene_text(text, sizeof text, shape, particles, transform);
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  sph_status st = sph_scene_load(s, path, NULL, 0, err);
-  unlink(path);
-  return st;
+  char text[2048];
+  sph_test_one_body(text, sizeof text, 3, "tl-jst", shape, particles,
+                    transform);
+  return sph_test_scene_load(text, s, err);
 }
 
 static sph_particles *particles_of(const char *shape, const char *particles,
                                    const char *transform) {
-  sph_scene *s;
-  sph_error err;
-  sph_status st = load(shape, particles, transform, &s, &err);
-  ck_assert_msg(st == SPH_OK, "%s: %s", shape, err.message);
-  sph_particles *ps;
-  st = sph_scene_build_particles(s, &ps, &err);
-  ck_assert_msg(st == SPH_OK, "%s: %s", shape, err.message);
-  sph_scene_destroy(s);
-  return ps;
-}
-
-static void assert_same(const sph_particles *a, const sph_particles *b,
-                        const char *what) {
-  ck_assert_msg(a->n == b->n, "%s: %zu particles, expected %zu", what, b->n,
-                a->n);
-  ck_assert_msg(!memcmp(a->field[SPH_FIELD_POSITION0],
-                        b->field[SPH_FIELD_POSITION0],
-                        3 * a->n * sizeof(double)),
-                "%s: positions differ", what);
-  ck_assert_msg(!memcmp(a->field[SPH_FIELD_VOLUME0],
-                        b->field[SPH_FIELD_VOLUME0], a->n * sizeof(double)),
-                "%s: volumes differ", what);
+  char text[2048];
+  sph_test_one_body(text, sizeof text, 3, "tl-jst", shape, particles,
+                    transform);
+  return sph_test_scene_particles(text, shape);
 }
 
 static const char *const box = "{box: {min: [0, 0, 0], max: [1, 1, 1]}}";
@@ -90,7 +47,7 @@ START_TEST(test_cube_is_the_box) {
   sph_particles *m =
       particles_of("{mesh: {file: " MESHES "cube.stl}}", lattices[0], NULL);
   ck_assert_uint_eq(b->n, 5 * 6 * 7);
-  assert_same(b, m, "cube.stl, count");
+  sph_test_assert_same_particles(b, m, "cube.stl, count");
   sph_particles_destroy(b);
   sph_particles_destroy(m);
 }
@@ -110,7 +67,7 @@ START_TEST(test_defective_cubes) {
       sph_particles *m = particles_of(files[f], lattices[l], NULL);
       char what[256];
       snprintf(what, sizeof what, "%s, %s", files[f], lattices[l]);
-      assert_same(ref, m, what);
+      sph_test_assert_same_particles(ref, m, what);
       sph_particles_destroy(m);
     }
     sph_particles_destroy(ref);
@@ -150,14 +107,6 @@ START_TEST(test_icosphere_is_the_sphere) {
 }
 END_TEST
 
-static int cmp_point(const void *a, const void *b) {
-  const double *x = a, *y = b;
-  for (int c = 0; c < 3; ++c)
-    if (x[c] != y[c])
-      return x[c] < y[c] ? -1 : 1;
-  return 0;
-}
-
 START_TEST(test_transform_is_the_moved_mesh) {
   /* turned 90 degrees about z and moved: exact in binary, so the same
    * points (in another order) */
@@ -169,8 +118,8 @@ START_TEST(test_transform_is_the_moved_mesh) {
   ck_assert_uint_eq(t->n, m->n);
   ck_assert_uint_eq(m->n, 8 * 8 * 4 * 3 / 4); /* the L: 3/4 of its box */
   double *a = t->field[SPH_FIELD_POSITION0], *b = m->field[SPH_FIELD_POSITION0];
-  qsort(a, t->n, 3 * sizeof *a, cmp_point);
-  qsort(b, m->n, 3 * sizeof *b, cmp_point);
+  qsort(a, t->n, 3 * sizeof *a, sph_test_cmp_point);
+  qsort(b, m->n, 3 * sizeof *b, sph_test_cmp_point);
   ck_assert(!memcmp(a, b, 3 * m->n * sizeof *a));
   sph_particles_destroy(t);
   sph_particles_destroy(m);
@@ -184,7 +133,7 @@ START_TEST(test_threads) {
   omp_set_num_threads(2);
   sph_particles *two = particles_of("{mesh: {file: " MESHES "icosphere.obj}}",
                                     "{spacing: 0.02}", NULL);
-  assert_same(one, two, "1 and 2 threads");
+  sph_test_assert_same_particles(one, two, "1 and 2 threads");
   sph_particles_destroy(one);
   sph_particles_destroy(two);
 }
@@ -275,12 +224,8 @@ static void refused(const char *shape, const char *particles, sph_status code,
   sph_scene *s;
   sph_error err;
   sph_status st = load(shape, particles, NULL, &s, &err);
-  ck_assert_msg(st == code, "%s: got %s (%s)", shape, sph_status_name(st),
-                err.message);
+  sph_test_assert_refused(st, &err, shape, code, key, fragment);
   ck_assert_int_eq(err.line, strstr(key, "particles") ? 11 : 10);
-  ck_assert_msg(!strcmp(err.key, key), "key %s, expected %s", err.key, key);
-  ck_assert_msg(strstr(err.message, fragment), "message '%s' lacks '%s'",
-                err.message, fragment);
 }
 
 START_TEST(test_bad_input) {
@@ -308,7 +253,7 @@ START_TEST(test_bad_input) {
   sph_particles *b = particles_of("{mesh: {file: " MESHES
                                   "cube_inverted.stl, flip_normals: true}}",
                                   p, NULL);
-  assert_same(a, b, "flip_normals");
+  sph_test_assert_same_particles(a, b, "flip_normals");
   sph_particles_destroy(a);
   sph_particles_destroy(b);
 }

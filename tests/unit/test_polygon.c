@@ -2,6 +2,7 @@
  * built-in box exactly, a hole and an L take their share of the lattice,
  * a turned polygon body is the pre-turned outline, rays through vertices
  * count once, and each refused input names its key. */
+#include "test_scene_util.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -16,43 +17,18 @@
 
 static sph_status load(int dim, const char *shape, const char *particles,
                        const char *transform, sph_scene **s, sph_error *err) {
-  char text[2048], path[64] = "/tmp/sph_polygon_XXXXXX";
-  snprintf(text, sizeof text,
-           "name: t\n"
-           "dimension: %d\n"
-           "method: {name: ul-sph}\n"
-           "materials:\n"
-           "  m: {model: neo-hookean, density: 1000, youngs_modulus: 1e6, "
-           "poisson_ratio: 0.3}\n"
-           "time: {end: 0.1}\n"
-           "bodies:\n"
-           "  - name: part\n"
-           "    material: m\n"
-           "    shape: %s\n"
-           "    particles: %s\n"
-           "%s%s\n",
-           dim, shape, particles, transform ? "    transform: " : "",
-           transform ? transform : "");
-  int fd = mkstemp(path);
-  ck_assert_int_ge(fd, 0);
-  ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  sph_status st = sph_scene_load(s, path, NULL, 0, err);
-  unlink(path);
-  return st;
+  char text[2048];
+  sph_test_one_body(text, sizeof text, dim, "ul-sph", shape, particles,
+                    transform);
+  return sph_test_scene_load(text, s, err);
 }
 
 static sph_particles *particles_of(const char *shape, const char *particles,
                                    const char *transform) {
-  sph_scene *s;
-  sph_error err;
-  sph_status st = load(2, shape, particles, transform, &s, &err);
-  ck_assert_msg(st == SPH_OK, "%s: %s", shape, err.message);
-  sph_particles *ps;
-  st = sph_scene_build_particles(s, &ps, &err);
-  ck_assert_msg(st == SPH_OK, "%s: %s", shape, err.message);
-  sph_scene_destroy(s);
-  return ps;
+  char text[2048];
+  sph_test_one_body(text, sizeof text, 2, "ul-sph", shape, particles,
+                    transform);
+  return sph_test_scene_particles(text, shape);
 }
 
 static const char *const square =
@@ -63,11 +39,7 @@ START_TEST(test_square_is_the_box) {
                                   "{spacing: 0.05}", NULL);
   sph_particles *p = particles_of(square, "{spacing: 0.05}", NULL);
   ck_assert_uint_eq(b->n, 400);
-  ck_assert_uint_eq(p->n, b->n);
-  ck_assert(!memcmp(b->field[SPH_FIELD_POSITION0],
-                    p->field[SPH_FIELD_POSITION0], 3 * b->n * sizeof(double)));
-  ck_assert(!memcmp(b->field[SPH_FIELD_VOLUME0], p->field[SPH_FIELD_VOLUME0],
-                    b->n * sizeof(double)));
+  sph_test_assert_same_particles(b, p, "square");
   sph_particles_destroy(b);
   sph_particles_destroy(p);
 }
@@ -89,14 +61,6 @@ START_TEST(test_hole_and_ell) {
 }
 END_TEST
 
-static int cmp_point(const void *a, const void *b) {
-  const double *x = a, *y = b;
-  for (int c = 0; c < 3; ++c)
-    if (x[c] != y[c])
-      return x[c] < y[c] ? -1 : 1;
-  return 0;
-}
-
 START_TEST(test_transform_is_the_moved_outline) {
   /* the L turned 90 degrees and moved by (2, 1): (x, y) -> (2 - y, 1 + x) */
   sph_particles *t = particles_of("{polygon: {points: [[0, 0], [1, 0], [1, "
@@ -109,8 +73,8 @@ START_TEST(test_transform_is_the_moved_outline) {
   ck_assert_uint_eq(t->n, 48);
   ck_assert_uint_eq(m->n, t->n);
   double *a = t->field[SPH_FIELD_POSITION0], *b = m->field[SPH_FIELD_POSITION0];
-  qsort(a, t->n, 3 * sizeof *a, cmp_point);
-  qsort(b, m->n, 3 * sizeof *b, cmp_point);
+  qsort(a, t->n, 3 * sizeof *a, sph_test_cmp_point);
+  qsort(b, m->n, 3 * sizeof *b, sph_test_cmp_point);
   ck_assert(!memcmp(a, b, 3 * m->n * sizeof *a));
   sph_particles_destroy(t);
   sph_particles_destroy(m);
@@ -142,11 +106,7 @@ static void refused(int dim, const char *shape, const char *particles,
   sph_scene *s;
   sph_error err;
   sph_status st = load(dim, shape, particles, NULL, &s, &err);
-  ck_assert_msg(st == code, "%s: got %s (%s)", shape, sph_status_name(st),
-                err.message);
-  ck_assert_msg(!strcmp(err.key, key), "key %s, expected %s", err.key, key);
-  ck_assert_msg(strstr(err.message, fragment), "message '%s' lacks '%s'",
-                err.message, fragment);
+  sph_test_assert_refused(st, &err, shape, code, key, fragment);
 }
 
 START_TEST(test_bad_input) {
