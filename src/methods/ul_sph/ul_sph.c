@@ -475,17 +475,58 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
   return SPH_OK;
 }
 
+/* the isochoric neo-Hookean energy G/2 (J^-2/3 tr C - 3) >= 0 per reference
+ * volume of particle a, F from the reference positions X over the pair
+ * geometry of the last configuration update (eq. 30-31: F^-1 = -A B, exact
+ * for a linear map; plane strain in 2D) */
+static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
+  const sph_neighbors *nl = m->nl;
+  const int32_t *body = m->sim->ps->body;
+  double M[9] = {0}, A[9] = {0}, B[9], Fi[9], F[9];
+  for (size_t s = nl->offset[a]; s < nl->offset[a + 1]; ++s) {
+    size_t b = (size_t)nl->index[s];
+    if (body[a] != body[b])
+      continue;
+    double Vb = m->m[b] / m->rho[b];
+    ul_sph_iact_moment(M, Vb, m->r[s], m->dW[s], m->e + 3 * s, dim);
+    ul_sph_iact_velocity_gradient(A, Vb, X + 3 * a, X + 3 * b, m->dW[s],
+                                  m->e + 3 * s, dim);
+  }
+  if (dim == 2)
+    M[8] = 1.0;
+  if (sph_mat3_inverse(M, B) == 0.0)
+    return 0.0;
+  sph_mat3_mul(A, B, Fi);
+  for (int k = 0; k < 9; ++k)
+    Fi[k] = -Fi[k];
+  if (dim == 2)
+    Fi[8] = 1.0;
+  double J = 1.0 / sph_mat3_inverse(Fi, F), trC = 0.0;
+  if (!(J > 0.0) || !isfinite(J))
+    return 0.0;
+  for (int k = 0; k < 9; ++k)
+    trC += F[k] * F[k];
+  double w = 0.5 * m->G[a] * (pow(J, -2.0 / 3.0) * trC - 3.0);
+  return m->m[a] / m->rho0[a] * (w > 0.0 ? w : 0.0);
+}
+
+/* Energies from the state: kinetic, and as strain the equation of state's
+ * volumetric energy plus shear_energy; the work booked against ENOG's shear
+ * force (m->work, a rate form without a potential) is not added, since it
+ * drifts where the force does net work (issue 35) */
 static void ul_sph_energy(sph_sim *sim, double *kinetic, double *strain) {
   ul_sph *m = sim->method_data;
+  const double *X = sim->ps->field[SPH_FIELD_POSITION0];
+  int dim = sim->scene->dimension;
   double ek = 0.0, es = 0.0;
-  for (size_t a = 0; a < m->n; ++a) {
+  for (long a = 0; a < (long)m->n; ++a) {
     ek += 0.5 * m->m[a] * sph_vec3_dot(m->v + 3 * a, m->v + 3 * a);
     double q = m->rho0[a] / m->rho[a];
-    es += m->m[a] * m->c0[a] * m->c0[a] * (q - 1.0 - log(q)) + m->work[a];
+    es += m->m[a] * m->c0[a] * m->c0[a] * (q - 1.0 - log(q)) +
+          shear_energy(m, a, X, dim);
   }
   *kinetic = ek;
   *strain = es;
-  (void)sim;
 }
 
 static int ul_sph_state(sph_sim *sim, sph_state_array *out) {
