@@ -318,9 +318,11 @@ START_TEST(rings_enog_past_the_rebound) {
    * 0.03 s: the rings meet at about 0.003 s, part at about 0.012 s and then
    * oscillate freely (seed 002 Fig. 16-18: no fracture, no zig-zag). The
    * verdict keeps its defaults (fracture beyond 2 dp, zig-zag above 0.5,
-   * energy growth). The booked total (kinetic + volumetric + work against
-   * the shear force) never exceeds its initial value and the kinetic energy
-   * stays below it. */
+   * energy growth). The kinetic energy stays below its initial value; the
+   * total from the state (kinetic + volumetric + the isochoric neo-Hookean
+   * energy of F, issue 35) within the verdict's bound: ENOG's shear force has
+   * no potential and agrees with that energy only to first order in the
+   * strain (measured: 0.08 c0 peaks 1.5 % above at the rebound, 0.006 s). */
   const double c0 = 117.85113019775793, frac[] = {0.06, 0.07, 0.08};
   for (int i = 0; i < 3; ++i) {
     double v0 = frac[i] * c0, area = M_PI * (0.04 * 0.04 - 0.03 * 0.03);
@@ -337,7 +339,7 @@ START_TEST(rings_enog_past_the_rebound) {
                   o.reason);
     ck_assert_msg(fabs(0.5 * rt.ke0 - ke) < 0.01 * ke, "kinetic %g vs %g",
                   0.5 * rt.ke0, ke);
-    ck_assert_msg(rt.e_max <= rt.ke0 * (1.0 + 1e-12),
+    ck_assert_msg(rt.e_max <= rt.ke0 * (1.0 + SPH_ENERGY_GROWTH_MAX),
                   "%g c0: total %g above its initial %g", frac[i], rt.e_max,
                   rt.ke0);
     ck_assert_msg(rt.ke_max <= rt.ke0, "%g c0: kinetic %g above initial %g",
@@ -357,15 +359,41 @@ END_TEST
 START_TEST(rings_limited_dissipation_gain_energy) {
   /* the twin: with eq. 16's limiter the Riemann dissipation acts only on
    * approaching pairs, and ENOG's shear force (no potential) creates kinetic
-   * energy after the rebound. Measured: energy growth trips at 0.0125 s. */
+   * energy after the rebound. Measured: energy growth tripped at 0.0125 s on
+   * the kinetic energy; on the total from the state (issue 35) at 0.0035 s,
+   * during the impact (249.1 of 234.6 J/m). */
   rings_track rt;
   outcome o = rings_to(0.08 * 117.85113019775793, "limited", 0.03, &rt);
   show("A8 rings 0.08 c0 limited", &o, "kinetic max %.4g of %.4g", rt.ke_max,
        rt.ke0);
   ck_assert_msg(!o.stable && o.first == SPH_INDICATOR_ENERGY_GROWTH,
                 "limited dissipation: %s", o.stable ? "stable" : o.reason);
-  ck_assert_msg(o.t_tripped > 0.010 && o.t_tripped < 0.016, "tripped at %g",
+  ck_assert_msg(o.t_tripped > 0.003 && o.t_tripped < 0.016, "tripped at %g",
                 o.t_tripped);
+}
+END_TEST
+
+START_TEST(rings_unequal_gain_energy) {
+  /* issue 35 item 3: a thin ring (inner radius 0.03) against a thick one
+   * (0.025) at 0.07 c0, dp 0.002: the thin ring folds at the impact into a
+   * shape whose stored energy (from F against the reference positions,
+   * measured 1126 J/m at 0.0055 s) exceeds the initial total 214.9 J/m, and
+   * ENOG's shear force barely resists it; the work booked against that force
+   * went to -83 J/m, and the verdict saw only the kinetic energy (growth at
+   * 0.027 s). The total from the state trips at the impact. */
+  const char *sets[] = {"bodies.0.particles.spacing=0.002",
+                        "bodies.1.particles.spacing=0.002",
+                        "bodies.0.initial_velocity.uniform=[8.2496,0,0]",
+                        "bodies.1.initial_velocity.uniform=[-8.2496,0,0]",
+                        "bodies.1.shape.ring.inner_radius=0.025",
+                        "time.end=0.03"};
+  rings_track rt = {0};
+  outcome o = run_case("colliding_rings", sets, 6, 0.0005, track_rings, &rt);
+  show("A8 rings thin against thick 0.07 c0", &o, "total max %.4g of %.4g",
+       rt.e_max, rt.ke0);
+  ck_assert_msg(!o.stable && o.first == SPH_INDICATOR_ENERGY_GROWTH,
+                "unequal rings: %s", o.stable ? "stable" : o.reason);
+  ck_assert_msg(o.t_tripped < 0.008, "tripped at %g", o.t_tripped);
 }
 END_TEST
 
@@ -382,6 +410,7 @@ int main(void) {
   tcase_add_test(tc, oscillating_plate_large_amplitude);
   tcase_add_test(tc, rings_enog_past_the_rebound);
   tcase_add_test(tc, rings_limited_dissipation_gain_energy);
+  tcase_add_test(tc, rings_unequal_gain_energy);
   suite_add_tcase(s, tc);
   return sph_test_run(s);
 }
