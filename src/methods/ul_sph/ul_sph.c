@@ -443,6 +443,8 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
   double *vm = ps->field[SPH_FIELD_VON_MISES];
   double *acc = ps->field[SPH_FIELD_ACCELERATION];
   long n = (long)m->n;
+  /* the ghosts' current positions, for the energy's F */
+  SPH_TRY(sph_domain_exchange(sim->domain, m->x, 3, err));
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     m->p[a] = m->c0[a] * m->c0[a] * (m->rho[a] - m->rho0[a]);
@@ -476,9 +478,11 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
 }
 
 /* the isochoric neo-Hookean energy G/2 (J^-2/3 tr C - 3) >= 0 per reference
- * volume of particle a, F from the reference positions X over the pair
- * geometry of the last configuration update (eq. 30-31: F^-1 = -A B, exact
- * for a linear map; plane strain in 2D) */
+ * volume of particle a, F from the reference positions X over the current
+ * positions of the neighbours of the last configuration update (ghosts' sent
+ * by ul_sph_derive) with the volumes of the last step
+ * (eq. 30-31: F^-1 = -A B, exact for a linear map; plane strain in 2D; 0
+ * before the first step, where F = I) */
 static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
   const sph_neighbors *nl = m->nl;
   const int32_t *body = m->sim->ps->body;
@@ -487,10 +491,18 @@ static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
     size_t b = (size_t)nl->index[s];
     if (body[a] != body[b])
       continue;
-    double Vb = m->m[b] / m->rho[b];
-    ul_sph_iact_moment(M, Vb, m->r[s], m->dW[s], m->e + 3 * s, dim);
-    ul_sph_iact_velocity_gradient(A, Vb, X + 3 * a, X + 3 * b, m->dW[s],
-                                  m->e + 3 * s, dim);
+    double d[3], e[3];
+    for (int c = 0; c < 3; ++c)
+      d[c] = m->x[3 * a + c] - m->x[3 * b + c];
+    double r = sph_vec3_norm(d);
+    if (!(r > 0.0))
+      continue;
+    for (int c = 0; c < 3; ++c)
+      e[c] = d[c] / r;
+    double dW = sph_kernel_dwdr(&m->sim->kernel, r);
+    double Vb = m->vol[b]; /* the last step's, ghosts' as the owners' */
+    ul_sph_iact_moment(M, Vb, r, dW, e, dim);
+    ul_sph_iact_velocity_gradient(A, Vb, X + 3 * a, X + 3 * b, dW, e, dim);
   }
   if (dim == 2)
     M[8] = 1.0;
@@ -501,9 +513,10 @@ static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
     Fi[k] = -Fi[k];
   if (dim == 2)
     Fi[8] = 1.0;
-  double J = 1.0 / sph_mat3_inverse(Fi, F), trC = 0.0;
-  if (!(J > 0.0) || !isfinite(J))
+  double dFi = sph_mat3_inverse(Fi, F), trC = 0.0;
+  if (!(dFi > 0.0))
     return 0.0;
+  double J = 1.0 / dFi;
   for (int k = 0; k < 9; ++k)
     trC += F[k] * F[k];
   double w = 0.5 * m->G[a] * (pow(J, -2.0 / 3.0) * trC - 3.0);
