@@ -443,8 +443,13 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
   double *vm = ps->field[SPH_FIELD_VON_MISES];
   double *acc = ps->field[SPH_FIELD_ACCELERATION];
   long n = (long)m->n;
-  /* the ghosts' current positions, for the energy's F */
-  SPH_TRY(sph_domain_exchange(sim->domain, m->x, 3, err));
+  /* the ghosts' current positions and densities, for the energy's F (the
+   * next step's pressure pass sends its own) */
+  if (sim->domain) {
+    double *f[] = {m->x, m->rho};
+    int nc[] = {3, 1};
+    SPH_TRY(sph_domain_exchange_many(sim->domain, f, nc, 2, err));
+  }
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < n; ++a) {
     m->p[a] = m->c0[a] * m->c0[a] * (m->rho[a] - m->rho0[a]);
@@ -480,9 +485,8 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
 /* the isochoric neo-Hookean energy G/2 (J^-2/3 tr C - 3) >= 0 per reference
  * volume of particle a, F from the reference positions X over the current
  * positions of the neighbours of the last configuration update (ghosts' sent
- * by ul_sph_derive) with the volumes of the last step
- * (eq. 30-31: F^-1 = -A B, exact for a linear map; plane strain in 2D; 0
- * before the first step, where F = I) */
+ * by ul_sph_derive) and their current volumes (eq. 30-31: F^-1 = -A B, exact
+ * for a linear map; plane strain in 2D) */
 static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
   const sph_neighbors *nl = m->nl;
   const int32_t *body = m->sim->ps->body;
@@ -500,7 +504,7 @@ static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
     for (int c = 0; c < 3; ++c)
       e[c] = d[c] / r;
     double dW = sph_kernel_dwdr(&m->sim->kernel, r);
-    double Vb = m->vol[b]; /* the last step's, ghosts' as the owners' */
+    double Vb = m->m[b] / m->rho[b];
     ul_sph_iact_moment(M, Vb, r, dW, e, dim);
     ul_sph_iact_velocity_gradient(A, Vb, X + 3 * a, X + 3 * b, dW, e, dim);
   }
