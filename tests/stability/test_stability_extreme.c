@@ -213,22 +213,28 @@ START_TEST(oscillating_plate_30_periods) {
    * Measured: the last period's amplitude is 1.03 times the first's, since
    * the plate also creeps: the tip's mean axial displacement grows by about
    * 1 mm/s (9.7 mm by 9 s; half the rate at H/dp 10), which lengthens the
-   * period from 0.271 to 0.300 s and the tip's lever. */
+   * period from 0.271 to 0.300 s and the tip's lever. Since issue 35 the
+   * energy is that of the state (the neo-Hookean energy of F), which sees
+   * the creep: it trips energy growth at 0.25 s (0.1709 of 0.1626 J/m;
+   * single-criterion stepping at 2.045 s; 6.149 J/m by 9 s with the
+   * amplitude unchanged), so the run goes on past the verdict and no other
+   * indicator may trip. */
   const char *sets[] = {"bodies.0.particles.spacing=0.004",
                         "bodies.0.shape.box.min=[-0.016,-0.01]", "time.end=9"};
   plate_track pt = {0};
   outcome o =
-      run_case("oscillating_plate_2d", sets, 3, 0.005, track_plate, &pt);
+      run_frames("oscillating_plate_2d", sets, 3, 0.005, track_plate, &pt, 1);
   show("B4 plate H/dp 5, 9 s", &o,
        "%d periods (first %.4f s, last %.4f s), amplitude first %.5f last "
        "%.5f (ratio %.4f), energy change %.2e, mean axial tip displacement "
        "over the last period %.2e m",
        pt.periods, pt.period_first, pt.period_last, pt.amp_first, pt.amp_last,
        pt.amp_last / pt.amp_first, (o.e1 - o.e0) / o.e0, pt.x_last);
-  ck_assert_msg(o.stable, "%s", o.reason);
+  ck_assert_msg(o.first == SPH_INDICATOR_ENERGY_GROWTH, "%s", o.reason);
+  for (int i = 0; i < SPH_INDICATOR_COUNT; ++i)
+    ck_assert_msg(i == SPH_INDICATOR_ENERGY_GROWTH || isnan(o.tripped_at[i]),
+                  "%s tripped", sph_indicator_key((sph_indicator)i));
   ck_assert_int_ge(pt.periods, 30);
-  ck_assert_msg(o.e_max <= o.e0 && o.e1 > 0.98 * o.e0,
-                "energy %g -> %g (max %g)", o.e0, o.e1, o.e_max);
   ck_assert_msg(pt.amp_last > 0.95 * pt.amp_first, "amplitude %g -> %g",
                 pt.amp_first, pt.amp_last);
 }
@@ -239,20 +245,28 @@ START_TEST(oscillating_plate_large_amplitude) {
    * (about 3 periods): stable with the full Riemann dissipation, the
    * energy never above its initial value (measured 4.064 -> 3.795 J/m,
    * period 0.309 at this resolution, 0.2817 at H/dp 10). The twin with eq.
-   * 16's limiter gains kinetic energy: measured, energy growth at 0.145 s. */
+   * 16's limiter gains kinetic energy: measured, energy growth at 0.145 s
+   * (0.075 s on the energy from the state). Since issue 35 the energy from the
+   * state sees the plate's creep (see above): full dissipation trips energy
+   * growth at 0.205 s (4.286 of 4.064 J/m), so the run goes on past the
+   * verdict, and no other indicator may trip. */
   const char *sets[] = {"bodies.0.particles.spacing=0.004",
                         "bodies.0.shape.box.min=[-0.016,-0.01]", "time.end=1",
                         "method.dissipation=full"};
-  outcome o = run("oscillating_plate_2d_large", sets, 4, 0.005);
-  ck_assert_msg(o.stable && o.t >= 1.0 - 1e-12, "%s", o.reason);
-  ck_assert_msg(o.e_max <= o.e0, "energy %g -> max %g", o.e0, o.e_max);
+  outcome o =
+      run_frames("oscillating_plate_2d_large", sets, 4, 0.005, NULL, NULL, 1);
+  show("oscillating_plate_2d_large", &o, NULL);
+  ck_assert_msg(o.t >= 1.0 - 1e-12, "%s", o.reason);
+  ck_assert_msg(o.first == SPH_INDICATOR_ENERGY_GROWTH, "%s", o.reason);
+  for (int i = 0; i < SPH_INDICATOR_COUNT; ++i)
+    ck_assert_msg(i == SPH_INDICATOR_ENERGY_GROWTH || isnan(o.tripped_at[i]),
+                  "%s tripped", sph_indicator_key((sph_indicator)i));
   ck_assert(o.stretch_max < SPH_FRACTURE_DP && o.pairs_over == 0);
   sets[3] = "method.dissipation=limited";
   outcome l = run("oscillating_plate_2d_large", sets, 4, 0.005);
   ck_assert_msg(!l.stable && l.first == SPH_INDICATOR_ENERGY_GROWTH,
                 "limited: %s", l.stable ? "stable" : l.reason);
-  ck_assert_msg(l.t_tripped > 0.1 && l.t_tripped < 0.2, "tripped at %g",
-                l.t_tripped);
+  ck_assert_msg(l.t_tripped < 0.2, "tripped at %g", l.t_tripped);
 }
 END_TEST
 
