@@ -445,7 +445,7 @@ static sph_status ul_sph_derive(sph_sim *sim, sph_error *err) {
   long n = (long)m->n;
   /* the ghosts' current positions and densities, for the energy's F (the
    * next step's pressure pass sends its own) */
-  if (sim->domain) {
+  if (sim->domain && m->state_energy) {
     double *f[] = {m->x, m->rho};
     int nc[] = {3, 1};
     SPH_TRY(sph_domain_exchange_many(sim->domain, f, nc, 2, err));
@@ -529,10 +529,10 @@ static double shear_energy(const ul_sph *m, long a, const double *X, int dim) {
   return m->m[a] / m->rho0[a] * (w > 0.0 ? w : 0.0);
 }
 
-/* Energies from the state: kinetic, and as strain the equation of state's
- * volumetric energy plus shear_energy; the work booked against ENOG's shear
- * force (m->work, a rate form without a potential) is not added, since it
- * drifts where the force does net work (issue 35) */
+/* kinetic, and as strain the equation of state's volumetric energy plus,
+ * with `energy: state`, shear_energy, else the work booked against the
+ * shear force (m->work, a rate form: ENOG's force has no potential, so it
+ * drifts negative where the force does net work, issue 35) */
 static void ul_sph_energy(sph_sim *sim, double *kinetic, double *strain) {
   ul_sph *m = sim->method_data;
   const double *X = sim->ps->field[SPH_FIELD_POSITION0];
@@ -542,7 +542,7 @@ static void ul_sph_energy(sph_sim *sim, double *kinetic, double *strain) {
     ek += 0.5 * m->m[a] * sph_vec3_dot(m->v + 3 * a, m->v + 3 * a);
     double q = m->rho0[a] / m->rho[a];
     es += m->m[a] * m->c0[a] * m->c0[a] * (q - 1.0 - log(q)) +
-          shear_energy(m, a, X, dim);
+          (m->state_energy ? shear_energy(m, a, X, dim) : m->work[a]);
   }
   *kinetic = ek;
   *strain = es;
@@ -704,6 +704,7 @@ static sph_status ul_sph_setup(sph_sim *sim, sph_node *opt, sph_error *err) {
   m->dual = o.dual;
   m->pressure_term = o.pressure_term;
   m->limited = o.limited;
+  m->state_energy = o.state_energy;
   m->cfl_ac = o.cfl_ac;
   m->cfl_ad = o.cfl_ad;
   m->zeta = o.zeta;
