@@ -19,6 +19,7 @@ typedef struct ul_sph_options {
   int dual;          /* time_stepping: dual (else single) */
   int pressure_term; /* continuity: riemann (else average) */
   int limited;       /* dissipation: limited (else full) */
+  int state_energy;  /* energy: state (else booked) */
   double cfl_ac, cfl_ad;
   double zeta;         /* shear: laplacian */
   double as_eps, as_n; /* shear: artificial-stress */
@@ -44,6 +45,7 @@ typedef struct ul_sph {
   int dual;          /* dual-criteria stepping (eq. 25-29), else single */
   int pressure_term; /* (P_L - P_R) in U* of the continuity equation */
   int limited;       /* limiter beta of eq. 16, else beta = 1 (full) */
+  int state_energy;  /* strain energy from the state, else booked */
   double cfl_ad, cfl_ac, zeta;
   double c0_max;              /* largest c0 of the bodies (eq. 26) */
   double as_eps, as_n, as_w0; /* artificial stress: epsilon, n, W(dp) */

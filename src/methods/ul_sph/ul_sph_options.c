@@ -40,10 +40,17 @@ static sph_status shear_options_parse(sph_node *opt, int dim, ul_sph_options *o,
 
 sph_status ul_sph_options_parse(sph_node *opt, int dim, ul_sph_options *o,
                                 sph_error *err) {
-  static const char *const keys[] = {
-      "name",          "shear",      "time_stepping", "cfl",
-      "cfl_advection", "continuity", "zeta",          "artificial_stress",
-      "dissipation",   NULL};
+  static const char *const keys[] = {"name",
+                                     "shear",
+                                     "time_stepping",
+                                     "cfl",
+                                     "cfl_advection",
+                                     "continuity",
+                                     "zeta",
+                                     "artificial_stress",
+                                     "dissipation",
+                                     "energy",
+                                     NULL};
   SPH_TRY(sph_node_check_keys(opt, keys, err));
   static const char *const shears[] = {"original", "artificial-stress",
                                        "laplacian", NULL};
@@ -66,6 +73,12 @@ sph_status ul_sph_options_parse(sph_node *opt, int dim, ul_sph_options *o,
    * (no potential) create energy after a rebound */
   SPH_TRY(sph_node_get_choice(opt, "dissipation", diss, "full", &ds, err));
   o->limited = ds == 0;
+  /* energy.csv's strain: the work booked against the shear force (a rate
+   * form), or the stored energy of the state (issue 35) */
+  static const char *const energy[] = {"booked", "state", NULL};
+  int en;
+  SPH_TRY(sph_node_get_choice(opt, "energy", energy, "booked", &en, err));
+  o->state_energy = en == 1;
   SPH_TRY(sph_node_get_double(opt, "cfl", 0, 0.4, &o->cfl_ac, err));
   if (!(o->cfl_ac > 0.0 && o->cfl_ac <= 1.0))
     return sph_node_error(sph_node_child(opt, "cfl"), err, SPH_ERR_RANGE,
