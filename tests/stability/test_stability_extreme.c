@@ -392,11 +392,12 @@ START_TEST(rings_unequal_gain_energy) {
   ck_assert_msg(!o.stable && o.first == SPH_INDICATOR_ENERGY_GROWTH,
                 "unequal rings: %s", o.stable ? "stable" : o.reason);
   ck_assert_msg(o.t_tripped < 0.008, "tripped at %g", o.t_tripped);
-  /* the booked total: only the kinetic energy trips, long after the fold */
+  /* the booked total (the default) trips only when the kinetic energy alone
+   * passes the initial total, long after the fold (0.027 s measured): shown,
+   * not asserted, so that a fix of ENOG's shear force does not fail here */
   sets[6] = "method.energy=booked";
   outcome b = run_case("colliding_rings", sets, 7, 0.0005, track_rings, &rt);
   show("A8 rings thin against thick, booked", &b, NULL);
-  ck_assert_msg(!b.stable && b.t_tripped > 0.02, "booked: %s", b.reason);
 }
 END_TEST
 
