@@ -222,6 +222,23 @@ static int cmp_first_i64(const void *pa, const void *pb) {
   return (a > b) - (a < b);
 }
 
+/* A snapshot's m particles taken: the drawn box and value range over the
+ * ranks (collective), the camera followed, the colour range set. */
+static void png_frame_close(png_sink *p, png_frame *s, size_t m, double vmin,
+                            double vmax, double amax) {
+  double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
+  sph_png_box(s->xyz, m, lo, hi);
+  lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
+  sph_domain_minmax(p->domain, lo, hi, 5);
+  memcpy(s->box_lo, lo, sizeof s->box_lo);
+  memcpy(s->box_hi, hi, sizeof s->box_hi);
+  if (p->follow)
+    sph_png_follow(p, lo, hi);
+  s->view = p->view;
+  s->m = m;
+  png_colour_range(p, s, lo[3], hi[3]);
+}
+
 /* The same over MPI ranks (collective): this rank's particles in the
  * serial draw order (by id) with their ids as keys, the cut evaluated on
  * them (they migrate), the box, value range, counts and percentiles
@@ -253,17 +270,7 @@ sph_status sph_png_snapshot_ranks(png_sink *p, const sph_frame *fr,
     png_take(p, ps, a, v, s, m++);
   }
   SPH_TRY(sph_domain_agree(p->domain, png_finite(s, m, err), err));
-  double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
-  sph_png_box(s->xyz, m, lo, hi);
-  lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
-  sph_domain_minmax(p->domain, lo, hi, 5);
-  memcpy(s->box_lo, lo, sizeof s->box_lo);
-  memcpy(s->box_hi, hi, sizeof s->box_hi);
-  if (p->follow)
-    sph_png_follow(p, lo, hi);
-  s->view = p->view;
-  s->m = m;
-  png_colour_range(p, s, lo[3], hi[3]);
+  png_frame_close(p, s, m, vmin, vmax, amax);
   s->time = fr->time;
   s->index = fr->index;
   return SPH_OK;
@@ -289,17 +296,7 @@ static void replay_frame(png_sink *p, const sph_particles *ps, const double *x,
     s->value[m++] = val;
     sph_png_hist_add(p, val);
   }
-  double lo[5], hi[5]; /* the drawn box, the value range, over the ranks */
-  sph_png_box(s->xyz, m, lo, hi);
-  lo[3] = vmin, hi[3] = vmax, lo[4] = 0.0, hi[4] = amax;
-  sph_domain_minmax(p->domain, lo, hi, 5);
-  memcpy(s->box_lo, lo, sizeof s->box_lo);
-  memcpy(s->box_hi, hi, sizeof s->box_hi);
-  if (p->follow)
-    sph_png_follow(p, lo, hi);
-  s->view = p->view;
-  s->m = m;
-  png_colour_range(p, s, lo[3], hi[3]);
+  png_frame_close(p, s, m, vmin, vmax, amax);
 }
 
 /* A resumed run's frames 0 .. frames - 1 are taken back from the stopped
